@@ -1,0 +1,114 @@
+"""The ``virja`` command: one console script with subcommands.
+
+Each subcommand lives in its own module ``virja.cli.cmd_<name>`` exposing
+``add_arguments(parser)`` and ``run(args) -> int``; its module docstring is its
+``--help`` text.  Modules are imported only when their subcommand runs, so a
+missing optional backend (GL, MIDI ports) never breaks the others.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+from collections.abc import Sequence
+
+from virja import __version__
+from virja.errors import VirjaError
+
+# name -> (module, one-line summary).  Order is the order of `virja --help`.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "serve": ("virja.cli.cmd_serve", "receive RMCP/1 over UDP and draw the band live"),
+    "send": ("virja.cli.cmd_send", "stream a MIDI file as RMCP/1, a stand-in performance generator"),
+    "plan": ("virja.cli.cmd_plan", "print the basic motions the scheduler picks for each note"),
+    "render": ("virja.cli.cmd_render", "render a MIDI file or a recording to PNG frames or video"),
+    "replay": ("virja.cli.cmd_replay", "replay a pcap recording of RMCP traffic"),
+    "jam": ("virja.cli.cmd_jam", "play a MIDI keyboard, the band plays what you play"),
+    "bench": ("virja.cli.cmd_bench", "measure speed and latency on this machine"),
+    "motion-report": ("virja.cli.cmd_motion_report", "impact, contact and continuity metrics"),
+    "beats": ("virja.cli.cmd_beats", "extract beat times from audio"),
+    "teach": ("virja.cli.cmd_teach", "build a motion database from a capture and its music"),
+    "dance": ("virja.cli.cmd_dance", "generate motion for new music from a database"),
+}
+
+NOT_YET = 2
+
+
+def _module_doc(modname: str) -> str | None:
+    try:
+        return importlib.import_module(modname).__doc__
+    except ModuleNotFoundError as exc:
+        if exc.name == modname:
+            return None
+        raise
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser; with ``only`` just that subcommand's module is imported."""
+    parser = argparse.ArgumentParser(
+        prog="virja",
+        description=__doc__.splitlines()[0] if __doc__ else None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"virja {__version__}")
+    parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging (-vv debug)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, (modname, summary) in COMMANDS.items():
+        if only is not None and name != only:
+            sub.add_parser(name, help=summary, add_help=False)
+            continue
+        try:
+            module = importlib.import_module(modname)
+        except ModuleNotFoundError as exc:
+            if exc.name != modname:
+                raise
+            p = sub.add_parser(name, help=f"{summary} (not available yet)", description=summary)
+            p.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+            p.set_defaults(_not_yet=True)
+            continue
+        p = sub.add_parser(
+            name,
+            help=summary,
+            description=module.__doc__,
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
+        module.add_arguments(p)
+        p.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``virja``; returns the exit status."""
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    only = next((a for a in args_list if a in COMMANDS), None)
+    parser = build_parser(only)
+    args = parser.parse_args(args_list)
+    logging.basicConfig(
+        level=logging.WARNING - 10 * min(args.verbose, 2),
+        format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+        stream=sys.stderr,
+    )
+    if args.command is None:
+        parser.print_help()
+        return NOT_YET
+    if getattr(args, "_not_yet", False):
+        print(
+            f"virja {args.command}: not implemented yet in this version "
+            "(see the issue tracker); nothing was done.",
+            file=sys.stderr,
+        )
+        return NOT_YET
+    try:
+        result: int = args._run(args)
+        return result
+    except VirjaError as exc:
+        print(f"virja {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"virja {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -18,7 +18,9 @@ def _data_dir(name: str) -> Path:
     checkout = Path(__file__).resolve().parent.parent / name
     if checkout.is_dir():
         return checkout
-    raise FileNotFoundError(f"virja package data folder {name!r} not found (looked in {packaged} and {checkout})")
+    raise FileNotFoundError(
+        f"virja package data folder {name!r} not found (looked in {packaged} and {checkout})"
+    )
 
 
 def shaders_dir() -> Path:

@@ -60,7 +60,9 @@ class TempoMap:
         self._times = [c[0] for c in self.changes]
 
     @classmethod
-    def from_changes(cls, changes: Iterable[tuple[float, float]], origin_s: float = 0.0) -> TempoMap:
+    def from_changes(
+        cls, changes: Iterable[tuple[float, float]], origin_s: float = 0.0
+    ) -> TempoMap:
         return cls(list(changes), origin_s)
 
     def seconds_per_beat_at(self, time_s: float) -> float:

@@ -20,7 +20,10 @@ from virja.errors import VirjaError
 # name -> (module, one-line summary).  Order is the order of `virja --help`.
 COMMANDS: dict[str, tuple[str, str]] = {
     "serve": ("virja.cli.cmd_serve", "receive RMCP/1 over UDP and draw the band live"),
-    "send": ("virja.cli.cmd_send", "stream a MIDI file as RMCP/1, a stand-in performance generator"),
+    "send": (
+        "virja.cli.cmd_send",
+        "stream a MIDI file as RMCP/1, a stand-in performance generator",
+    ),
     "plan": ("virja.cli.cmd_plan", "print the basic motions the scheduler picks for each note"),
     "render": ("virja.cli.cmd_render", "render a MIDI file or a recording to PNG frames or video"),
     "replay": ("virja.cli.cmd_replay", "replay a pcap recording of RMCP traffic"),
@@ -52,7 +55,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"virja {__version__}")
-    parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging (-vv debug)")
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0, help="more logging (-vv debug)"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (modname, summary) in COMMANDS.items():
         if only is not None and name != only:

@@ -1,0 +1,62 @@
+// Solid, lit, instanced primitives: every limb, drum, cymbal and the stage.
+// One unit mesh per primitive kind (cylinder, sphere, box) is drawn once per
+// instance with its own model matrix and colour (see virja/render/meshes.py).
+
+#if defined VERTEX_SHADER
+
+uniform mat4 u_view_proj;
+
+in vec3 in_position;   // unit mesh, object space
+in vec3 in_normal;
+in mat4 in_model;      // per instance: object -> world (metres)
+in vec4 in_color;      // per instance: linear RGB, alpha = shininess 0..1
+
+out vec3 v_world;
+out vec3 v_normal;
+out vec4 v_color;
+
+void main() {
+    vec4 world = in_model * vec4(in_position, 1.0);
+    // normals through the inverse transpose; instances are affine with no shear
+    mat3 normal_matrix = transpose(inverse(mat3(in_model)));
+    v_world = world.xyz;
+    v_normal = normalize(normal_matrix * in_normal);
+    v_color = in_color;
+    gl_Position = u_view_proj * world;
+}
+
+#elif defined FRAGMENT_SHADER
+
+uniform vec3 u_eye;
+uniform vec3 u_key_dir;      // towards the key light (normalised)
+uniform vec3 u_fill_dir;     // towards the fill light (normalised)
+uniform vec3 u_spot_pos;     // stage spot light position
+uniform vec3 u_fog_color;
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec4 v_color;
+
+out vec4 f_color;
+
+void main() {
+    vec3 n = normalize(v_normal);
+    if (!gl_FrontFacing) n = -n;
+    vec3 view = normalize(u_eye - v_world);
+    vec3 base = v_color.rgb;
+    float key = max(dot(n, u_key_dir), 0.0);
+    float fill = max(dot(n, u_fill_dir), 0.0);
+    vec3 to_spot = u_spot_pos - v_world;
+    float spot_d = length(to_spot);
+    float spot = max(dot(n, to_spot / spot_d), 0.0) * 6.0 / (1.0 + spot_d * spot_d);
+    float rim = pow(1.0 - max(dot(n, view), 0.0), 3.0) * 0.35;
+    vec3 h = normalize(u_key_dir + view);
+    float spec = pow(max(dot(n, h), 0.0), 8.0 + 120.0 * v_color.a) * v_color.a;
+    vec3 lit = base * (0.22 + 0.75 * key + 0.25 * fill + 0.35 * spot) + vec3(spec + rim * 0.6);
+    // gentle distance haze so the back of the stage falls away
+    float haze = clamp((length(u_eye - v_world) - 4.0) / 14.0, 0.0, 0.6);
+    vec3 rgb = mix(lit, u_fog_color, haze);
+    f_color = vec4(pow(rgb, vec3(1.0 / 2.2)), 1.0);
+}
+
+#endif

@@ -1,0 +1,70 @@
+"""Routing notes to performers: drums on channel 10, GM basses, bass-named tracks, overrides."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import DEMO_MID
+from virja.errors import ConfigError
+from virja.events import NoteOn, ProgramChange
+from virja.midifile import read_midi
+from virja.routing import Router, RoutingConfig, looks_like_bass, route_all
+
+
+def test_channel_10_goes_to_the_drummer() -> None:
+    assert Router().route(NoteOn(0, 9, 38, 100)) == "drums"
+
+
+def test_gm_bass_program_goes_to_the_bassist() -> None:
+    r = Router()
+    r.route(ProgramChange(0, 2, 33))
+    assert r.route(NoteOn(0.1, 2, 40, 90)) == "bass"
+
+
+def test_piano_part_never_reaches_the_bassist_even_on_a_bass_named_track() -> None:
+    r = Router(track_names={1: "Bass"})
+    r.route(ProgramChange(0, 0, 0, track=1))  # the program says piano
+    assert r.route(NoteOn(0.1, 0, 40, 90, track=1)) is None
+
+
+def test_bass_named_track_without_program_goes_to_the_bassist() -> None:
+    r = Router(track_names={1: "Walking bass"})
+    assert r.route(NoteOn(0.0, 3, 40, 90, track=1)) == "bass"
+
+
+def test_unprogrammed_unnamed_part_is_not_the_bands() -> None:
+    assert Router().route(NoteOn(0.0, 0, 60, 90)) is None
+
+
+@pytest.mark.parametrize("name, expected", [("Bass", True), ("Acoustic Bass 1", True), ("Kontrabass", True), ("Bass Drum", False), ("Bassoon", False), ("Piano", False)])
+def test_bass_track_names(name: str, expected: bool) -> None:
+    assert looks_like_bass(name) is expected
+
+
+def test_config_overrides_channels_and_tracks() -> None:
+    cfg = RoutingConfig.from_dict({"channels": {"1": "bass"}, "tracks": {"Kit": "drums"}})
+    r = Router(cfg, track_names={4: "Kit"})
+    assert r.route(NoteOn(0, 0, 40, 90)) == "bass"
+    assert r.route(NoteOn(0, 5, 38, 90, track=4)) == "drums"
+
+
+def test_cli_flags_win_over_the_file() -> None:
+    cfg = RoutingConfig.from_dict({"channels": {"2": "drums"}}).with_overrides(bass_channels=[2])
+    assert Router(cfg).route(NoteOn(0, 1, 40, 90)) == "bass"
+
+
+@pytest.mark.parametrize("table, text", [({"channels": {"17": "bass"}}, "1-16"), ({"channels": {"2": "piano"}}, "must be one of"), ({"colour": 1}, "unknown key")])
+def test_bad_routing_config_is_a_clear_error(table: dict[str, object], text: str) -> None:
+    with pytest.raises(ConfigError, match=text):
+        RoutingConfig.from_dict(table)
+
+
+def test_demo_routes_bass_and_drums_and_ignores_the_piano() -> None:
+    s = read_midi(DEMO_MID)
+    r = Router.for_session(s)
+    routed = route_all(s.events, r)
+    performers = {p for p, _ in routed}
+    assert performers == {"bass", "drums"}
+    assert not any(ev.channel == 0 for _, ev in routed)
+    report = "\n".join(r.report())
+    assert "'Piano'" in report and "not the band's" in report

@@ -1,0 +1,198 @@
+"""Standard MIDI files (type 0 and 1) to virja events.
+
+Times are seconds from the start of the file, computed through the file's
+whole tempo map (set_tempo in any track applies to every track, as in type 1
+files), so tempo changes mid-file are honoured.  mido decodes running status;
+a note_on with velocity 0 becomes a :class:`~virja.events.NoteOff`.
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mido
+
+from virja.errors import InputFileError
+from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.tempo import DEFAULT_SECONDS_PER_BEAT, TempoMap
+
+DEFAULT_TEMPO_US = 500_000
+
+
+@dataclass(frozen=True)
+class TrackInfo:
+    """What a track holds, for routing and for the CLI's report."""
+
+    index: int
+    name: str
+    channels: frozenset[int]
+    programs: frozenset[int]
+    note_count: int
+
+
+@dataclass
+class MidiSession:
+    """A MIDI file read into events; ``events`` sorted by time (stable)."""
+
+    path: Path
+    events: list[Event]
+    tempo_map: TempoMap
+    beats: list[Beat]
+    tracks: list[TrackInfo]
+    duration_s: float
+    ticks_per_beat: int
+    time_signatures: list[tuple[float, int, int]] = field(default_factory=list)
+
+    @property
+    def notes(self) -> list[NoteOn]:
+        return [e for e in self.events if isinstance(e, NoteOn)]
+
+
+class _TickClock:
+    """Absolute tick -> seconds through a list of (tick, tempo_us) changes."""
+
+    def __init__(self, changes: list[tuple[int, int]], ticks_per_beat: int) -> None:
+        changes = sorted(changes, key=lambda c: c[0])
+        if not changes or changes[0][0] != 0:
+            changes.insert(0, (0, DEFAULT_TEMPO_US))
+        # later changes at the same tick win
+        merged: dict[int, int] = {}
+        for tick, tempo in changes:
+            merged[tick] = tempo
+        self.ticks = sorted(merged)
+        self.tempos = [merged[t] for t in self.ticks]
+        self.tpb = ticks_per_beat
+        self.seconds: list[float] = [0.0]
+        for i in range(1, len(self.ticks)):
+            span = self.ticks[i] - self.ticks[i - 1]
+            self.seconds.append(self.seconds[-1] + span * self.tempos[i - 1] / 1e6 / self.tpb)
+
+    def to_seconds(self, tick: int) -> float:
+        i = bisect.bisect_right(self.ticks, tick) - 1
+        return self.seconds[i] + (tick - self.ticks[i]) * self.tempos[i] / 1e6 / self.tpb
+
+    def tempo_map(self) -> TempoMap:
+        return TempoMap.from_changes(
+            [(s, t / 1e6) for s, t in zip(self.seconds, self.tempos, strict=True)]
+        )
+
+
+def _open(path: Path) -> mido.MidiFile:
+    if not path.exists():
+        raise InputFileError(path, "no such file")
+    if path.is_dir():
+        raise InputFileError(path, "is a folder, not a MIDI file")
+    try:
+        return mido.MidiFile(str(path), clip=False)
+    except (OSError, EOFError, ValueError, KeyError, IndexError, TypeError) as exc:
+        raise InputFileError(path, f"not a readable MIDI file: {exc}") from exc
+
+
+def read_midi(path: str | Path) -> MidiSession:
+    """Read a type 0 or 1 MIDI file; raises InputFileError naming the file."""
+    p = Path(path)
+    mf = _open(p)
+    if mf.type == 2:
+        raise InputFileError(p, "type 2 MIDI files (independent sequences) are not supported")
+    if mf.ticks_per_beat <= 0:
+        raise InputFileError(p, "SMPTE time division is not supported (ticks per beat needed)")
+    tempo_changes: list[tuple[int, int]] = []
+    sigs: list[tuple[int, int, int]] = []
+    for track in mf.tracks:
+        tick = 0
+        for msg in track:
+            tick += msg.time
+            if msg.type == "set_tempo":
+                tempo_changes.append((tick, msg.tempo))
+            elif msg.type == "time_signature":
+                sigs.append((tick, msg.numerator, msg.denominator))
+    clock = _TickClock(tempo_changes, mf.ticks_per_beat)
+
+    events: list[tuple[int, int, int, Event]] = []  # (tick, track, order, event)
+    infos: list[TrackInfo] = []
+    end_tick = 0
+    order = 0
+    for ti, track in enumerate(mf.tracks):
+        tick = 0
+        name = ""
+        channels: set[int] = set()
+        programs: set[int] = set()
+        n_notes = 0
+        for msg in track:
+            tick += msg.time
+            if msg.is_meta:
+                if msg.type == "track_name" and not name:
+                    name = str(msg.name).strip()
+                continue
+            t = clock.to_seconds(tick)
+            ev: NoteOn | NoteOff | ControlChange | ProgramChange | None = None
+            if msg.type == "note_on" and msg.velocity > 0:
+                ev = NoteOn(t, msg.channel, msg.note, msg.velocity, track=ti)
+                n_notes += 1
+            elif msg.type == "note_off" or msg.type == "note_on":
+                ev = NoteOff(t, msg.channel, msg.note, msg.velocity, track=ti)
+            elif msg.type == "control_change":
+                ev = ControlChange(t, msg.channel, msg.control, msg.value, track=ti)
+            elif msg.type == "program_change":
+                ev = ProgramChange(t, msg.channel, msg.program, track=ti)
+                programs.add(msg.program)
+            if ev is not None:
+                channels.add(ev.channel)
+                events.append((tick, ti, order, ev))
+                order += 1
+        end_tick = max(end_tick, tick)
+        infos.append(TrackInfo(ti, name, frozenset(channels), frozenset(programs), n_notes))
+
+    # time order; at one tick note-offs before note-ons so a repeated note restarts cleanly
+    def key(item: tuple[int, int, int, Event]) -> tuple[int, int, int]:
+        tick, _track, seq, ev = item
+        return (tick, 0 if isinstance(ev, NoteOff) else 1, seq)
+
+    events.sort(key=key)
+    duration = clock.to_seconds(end_tick)
+    tempo_map = clock.tempo_map()
+    sig_s = [(clock.to_seconds(t), n, d) for t, n, d in sorted(sigs)]
+    beats = _beats(clock, sorted(sigs), end_tick, mf.ticks_per_beat)
+    return MidiSession(
+        path=p,
+        events=[e for *_, e in events],
+        tempo_map=tempo_map,
+        beats=beats,
+        tracks=infos,
+        duration_s=duration,
+        ticks_per_beat=mf.ticks_per_beat,
+        time_signatures=sig_s,
+    )
+
+
+def _beats(
+    clock: _TickClock, sigs: list[tuple[int, int, int]], end_tick: int, tpb: int
+) -> list[Beat]:
+    """Beats from the time signatures (4/4 when none), up to the end of the file."""
+    if not sigs or sigs[0][0] != 0:
+        sigs = [(0, 4, 4), *sigs]
+    out: list[Beat] = []
+    bar = 0
+    for i, (start, num, den) in enumerate(sigs):
+        stop = sigs[i + 1][0] if i + 1 < len(sigs) else end_tick + 1
+        beat_ticks = max(1, tpb * 4 // max(den, 1))
+        tick = start
+        beat_in_bar = 1
+        while tick < stop:
+            t = clock.to_seconds(tick)
+            spb = clock.to_seconds(tick + beat_ticks) - t
+            level = 2 if beat_in_bar == 1 else (1 if num % 2 == 0 and beat_in_bar % 2 == 1 else 0)
+            out.append(Beat(t, bar, beat_in_bar, num, level, max(1, round(spb * 1e6))))
+            tick += beat_ticks
+            beat_in_bar += 1
+            if beat_in_bar > num:
+                beat_in_bar = 1
+                bar += 1
+        if beat_in_bar != 1:
+            bar += 1
+    return out
+
+
+__all__ = ["MidiSession", "TrackInfo", "read_midi", "DEFAULT_SECONDS_PER_BEAT"]

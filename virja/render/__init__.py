@@ -1,0 +1,1 @@
+"""Drawing the band with moderngl: shaders, meshes, camera, hosts, video."""

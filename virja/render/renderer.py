@@ -1,0 +1,127 @@
+"""The GL side: instanced primitives drawn with one program, a few calls a frame.
+
+:class:`DrawList` collects instances per mesh kind (transforms and colours as
+numpy arrays); :class:`Renderer` uploads them and draws them into whatever
+framebuffer the host gives (a window's screen or an offscreen target).  It
+knows nothing of notes or skeletons: ``virja.render.scene`` turns a
+``BandPose`` into a DrawList.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+from virja.render.camera import Camera
+from virja.render.meshes import MESHES, pack_instances
+from virja.render.shaders import load_program
+
+F64 = NDArray[np.float64]
+
+BACKGROUND = (0.055, 0.06, 0.085)
+
+
+@dataclass
+class DrawList:
+    """Instances to draw this frame, per mesh kind."""
+
+    models: dict[str, list[F64]] = field(default_factory=dict)
+    colors: dict[str, list[F64]] = field(default_factory=dict)
+
+    def add(self, kind: str, models: F64, color: F64 | tuple[float, ...]) -> None:
+        if kind not in MESHES:
+            raise ValueError(f"unknown mesh kind {kind!r}; known: {sorted(MESHES)}")
+        m = np.asarray(models, dtype=np.float64).reshape(-1, 4, 4)
+        if len(m) == 0:
+            return
+        c = np.asarray(color, dtype=np.float64)
+        c = np.broadcast_to(c.reshape(-1, 4) if c.size % 4 == 0 else c, (len(m), 4))
+        self.models.setdefault(kind, []).append(m)
+        self.colors.setdefault(kind, []).append(np.array(c))
+
+    def packed(self, kind: str) -> NDArray[np.float32]:
+        if kind not in self.models:
+            return np.zeros((0, 20), dtype=np.float32)
+        return pack_instances(np.concatenate(self.models[kind]), np.concatenate(self.colors[kind]))
+
+    def count(self) -> int:
+        return sum(sum(len(m) for m in ms) for ms in self.models.values())
+
+
+class Renderer:
+    """Draws DrawLists with the ``solid`` program."""
+
+    def __init__(self, ctx: moderngl.Context, initial_instances: int = 512) -> None:
+        self.ctx = ctx
+        self.program = load_program(ctx, "solid")
+        self._vbos: dict[str, moderngl.Buffer] = {}
+        self._ibos: dict[str, moderngl.Buffer] = {}
+        self._vaos: dict[str, moderngl.VertexArray] = {}
+        self._capacity: dict[str, int] = {}
+        for kind, make in MESHES.items():
+            mesh = make()
+            self._vbos[kind] = ctx.buffer(mesh.tobytes())
+            self._alloc(kind, initial_instances)
+
+    def _alloc(self, kind: str, capacity: int) -> None:
+        if kind in self._ibos:
+            self._vaos[kind].release()
+            self._ibos[kind].release()
+        self._ibos[kind] = self.ctx.buffer(reserve=capacity * 20 * 4, dynamic=True)
+        self._capacity[kind] = capacity
+        self._vaos[kind] = self.ctx.vertex_array(
+            self.program,
+            [
+                (self._vbos[kind], "3f 3f", "in_position", "in_normal"),
+                (self._ibos[kind], "16f 4f/i", "in_model", "in_color"),
+            ],
+        )
+
+    def draw(self, draw_list: DrawList, camera: Camera, fbo: moderngl.Framebuffer) -> None:
+        """Clear ``fbo`` and draw every instance as seen by ``camera``."""
+        w, h = fbo.size
+        fbo.use()
+        self.ctx.viewport = (0, 0, w, h)
+        fbo.clear(*BACKGROUND, 1.0, depth=1.0)
+        self.ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        vp = camera.view_proj(w / max(h, 1))
+        self._uniform("u_view_proj").write(vp.T.astype("f4").tobytes())
+        eye = camera.eye
+        self._set("u_eye", tuple(float(x) for x in eye))
+        self._set("u_key_dir", _unit((0.35, 0.85, 0.55)))
+        self._set("u_fill_dir", _unit((-0.6, 0.3, 0.4)))
+        self._set("u_spot_pos", (0.0, 3.2, 1.6))
+        self._set("u_fog_color", BACKGROUND)
+        for kind in MESHES:
+            data = draw_list.packed(kind)
+            n = len(data)
+            if n == 0:
+                continue
+            if n > self._capacity[kind]:
+                self._alloc(kind, max(n, 2 * self._capacity[kind]))
+            self._ibos[kind].write(data.tobytes())
+            self._vaos[kind].render(moderngl.TRIANGLES, instances=n)
+
+    def _uniform(self, name: str) -> moderngl.Uniform:
+        member = self.program[name]
+        assert isinstance(member, moderngl.Uniform)
+        return member
+
+    def _set(self, name: str, value: tuple[float, ...]) -> None:
+        if name in self.program:
+            self._uniform(name).value = value
+
+    def release(self) -> None:
+        for d in (self._vaos, self._ibos, self._vbos):
+            for obj in d.values():
+                obj.release()
+        self.program.release()
+
+
+def _unit(v: tuple[float, float, float]) -> tuple[float, float, float]:
+    a = np.asarray(v, dtype=np.float64)
+    a /= np.linalg.norm(a)
+    return (float(a[0]), float(a[1]), float(a[2]))

@@ -1,0 +1,193 @@
+"""Video files: frames piped to ffmpeg (H.264), sound rendered by fluidsynth (AAC).
+
+ffmpeg comes from imageio-ffmpeg (a static build on PyPI, so no system
+package is needed); fluidsynth and a General MIDI soundfont are Debian
+packages (``fluidsynth``, ``fluid-soundfont-gm``).  Where either is missing the
+video is made silent and the caller is told why.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import mido
+import numpy as np
+from numpy.typing import NDArray
+
+from virja.errors import NotAvailableError
+from virja.events import ControlChange, Event, NoteOff, NoteOn, ProgramChange
+
+log = logging.getLogger(__name__)
+
+SOUNDFONT_PATHS = (
+    "/usr/share/sounds/sf2/FluidR3_GM.sf2",
+    "/usr/share/sounds/sf2/default-GM.sf2",
+    "/usr/share/soundfonts/FluidR3_GM.sf2",
+    "/usr/share/soundfonts/default.sf2",
+)
+
+
+def ffmpeg_exe() -> str:
+    try:
+        import imageio_ffmpeg
+
+        return str(imageio_ffmpeg.get_ffmpeg_exe())
+    except Exception as exc:  # imageio-ffmpeg raises RuntimeError when no binary fits
+        found = shutil.which("ffmpeg")
+        if found:
+            return found
+        raise NotAvailableError(f"no ffmpeg for video output ({exc})") from exc
+
+
+def find_soundfont(explicit: str | None = None) -> Path | None:
+    """The GM soundfont to use: ``explicit``, $VIRJA_SOUNDFONT, or a Debian path."""
+    for cand in (explicit, os.environ.get("VIRJA_SOUNDFONT"), *SOUNDFONT_PATHS):
+        if cand and Path(cand).is_file():
+            return Path(cand)
+    return None
+
+
+def events_to_midi(events: Iterable[Event], path: Path, t0_s: float = 0.0) -> None:
+    """Write note, controller and program events as a type 0 MIDI file starting at ``t0_s``."""
+    tpb, tempo = 960, 500_000  # 1 tick = 1/1920 s at 120 bpm
+    msgs: list[tuple[int, int, mido.Message]] = []
+    for i, ev in enumerate(events):
+        tick = max(0, round((ev.time_s - t0_s) * 1e6 / tempo * tpb))
+        if isinstance(ev, NoteOn):
+            m = mido.Message("note_on", channel=ev.channel, note=ev.note, velocity=ev.velocity)
+        elif isinstance(ev, NoteOff):
+            m = mido.Message("note_off", channel=ev.channel, note=ev.note, velocity=ev.velocity)
+        elif isinstance(ev, ControlChange):
+            m = mido.Message(
+                "control_change", channel=ev.channel, control=ev.control, value=ev.value
+            )
+        elif isinstance(ev, ProgramChange):
+            m = mido.Message("program_change", channel=ev.channel, program=ev.program)
+        else:
+            continue
+        msgs.append((tick, i, m))
+    msgs.sort(key=lambda x: (x[0], x[1]))
+    track = mido.MidiTrack()
+    track.append(mido.MetaMessage("set_tempo", tempo=tempo, time=0))
+    now = 0
+    for tick, _, m in msgs:
+        track.append(m.copy(time=tick - now))
+        now = tick
+    mf = mido.MidiFile(type=0, ticks_per_beat=tpb)
+    mf.tracks.append(track)
+    mf.save(str(path))
+
+
+def render_audio(
+    midi_path: Path, wav_path: Path, soundfont: Path, sample_rate: int = 44100
+) -> None:
+    """MIDI -> WAV with fluidsynth (fast, offline, no audio device)."""
+    exe = shutil.which("fluidsynth")
+    if exe is None:
+        raise NotAvailableError("fluidsynth is not installed (apt-get install fluidsynth)")
+    cmd = [
+        exe,
+        "-ni",
+        "-q",
+        "-g",
+        "0.8",
+        "-r",
+        str(sample_rate),
+        "-F",
+        str(wav_path),
+        str(soundfont),
+        str(midi_path),
+    ]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600, check=False)
+    if proc.returncode != 0 or not wav_path.exists():
+        raise NotAvailableError(
+            f"fluidsynth failed ({proc.returncode}): {proc.stderr.strip()[:300]}"
+        )
+
+
+class VideoWriter:
+    """Pipes RGB frames to ffmpeg; adds an audio track at ``audio_offset_s`` if given."""
+
+    def __init__(
+        self,
+        path: Path,
+        size: tuple[int, int],
+        fps: float,
+        audio: Path | None = None,
+        audio_offset_s: float = 0.0,
+        crf: int = 20,
+        preset: str = "veryfast",
+    ) -> None:
+        w, h = size
+        if w % 2 or h % 2:
+            raise ValueError(f"H.264 needs an even frame size, got {w}x{h}")
+        self.path = path
+        self.size = size
+        cmd = [
+            ffmpeg_exe(), "-y", "-loglevel", "error",
+            "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", f"{fps}", "-i", "-",
+        ]  # fmt: skip
+        if audio is not None:
+            cmd += ["-itsoffset", f"{audio_offset_s:.6f}", "-i", str(audio)]
+        cmd += ["-c:v", "libx264", "-preset", preset, "-crf", str(crf), "-pix_fmt", "yuv420p"]
+        cmd += ["-threads", "2", "-movflags", "+faststart"]
+        if audio is not None:
+            cmd += ["-c:a", "aac", "-b:a", "160k", "-map", "0:v:0", "-map", "1:a:0"]
+        cmd += [str(path)]
+        self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        self.frames = 0
+
+    def write(self, rgb: NDArray[np.uint8]) -> None:
+        assert self._proc.stdin is not None
+        if rgb.shape != (self.size[1], self.size[0], 3):
+            raise ValueError(
+                f"frame of shape {rgb.shape}, expected {(self.size[1], self.size[0], 3)}"
+            )
+        try:
+            self._proc.stdin.write(np.ascontiguousarray(rgb).tobytes())
+        except BrokenPipeError as exc:
+            raise NotAvailableError(f"ffmpeg stopped: {self._stderr()}") from exc
+        self.frames += 1
+
+    def _stderr(self) -> str:
+        assert self._proc.stderr is not None
+        return self._proc.stderr.read().decode(errors="replace").strip()[:500]
+
+    def close(self) -> None:
+        assert self._proc.stdin is not None
+        self._proc.stdin.close()
+        rc = self._proc.wait()
+        if rc != 0:
+            raise NotAvailableError(f"ffmpeg failed ({rc}): {self._stderr()}")
+
+
+def make_audio_track(
+    events: list[Event], t0_s: float, workdir: Path, soundfont: str | None = None
+) -> tuple[Path | None, str | None]:
+    """Render ``events`` to a WAV in ``workdir``; returns (wav, None) or (None, why not)."""
+    sf = find_soundfont(soundfont)
+    if sf is None:
+        return (
+            None,
+            "no General MIDI soundfont found (apt-get install fluid-soundfont-gm, or set VIRJA_SOUNDFONT); the video is silent",
+        )
+    if not any(isinstance(e, NoteOn) for e in events):
+        return None, "no notes to sound; the video is silent"
+    mid = workdir / "audio.mid"
+    wav = workdir / "audio.wav"
+    events_to_midi(events, mid, t0_s=t0_s)
+    try:
+        render_audio(mid, wav, sf)
+    except NotAvailableError as exc:
+        return None, f"{exc}; the video is silent"
+    return wav, None
+
+
+def temp_workdir() -> tempfile.TemporaryDirectory[str]:
+    return tempfile.TemporaryDirectory(prefix="virja-")

@@ -1,0 +1,198 @@
+"""Which performer plays an event: the drummer, the bassist, or nobody.
+
+Rules, in order (the first that decides wins), all data in
+:class:`RoutingConfig` so a user can override them from TOML or flags:
+
+1. a track named in ``tracks`` (case-insensitive, exact name) -> that performer
+   ("bass", "drums" or "none");
+2. a channel listed in ``channels`` -> that performer;
+3. a drum channel (default MIDI channel 10, index 9) -> drums;
+4. the GM program in force on the channel is a bass (32-39) -> bass; any other
+   program -> nobody (a piano part never makes the bassist play chords);
+5. no program seen on the channel, and the track's name looks like a bass part
+   (``bass_track_words``) -> bass;
+6. otherwise nobody.
+
+Channels in the config are 1-based, as musicians count them; events carry
+0-based channels.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from virja.errors import ConfigError
+from virja.events import Event, NoteOff, NoteOn, Performer, ProgramChange
+
+GM_BASS_PROGRAMS = frozenset(range(32, 40))  # Acoustic Bass .. Synth Bass 2 (0-based)
+DEFAULT_BASS_WORDS = ("bass", "contrabass", "kontrabass", "basse", "bajo", "baixo", "upright")
+# words that mean the track is not a bass part even though it contains "bass"
+DEFAULT_NOT_BASS_WORDS = ("drum", "bassdrum", "bass drum", "kick")
+
+Route = Performer | None
+_TARGETS: dict[str, Route] = {"bass": "bass", "drums": "drums", "none": None}
+
+
+@dataclass(frozen=True)
+class RoutingConfig:
+    drum_channels: frozenset[int] = frozenset({10})  # 1-based
+    bass_programs: frozenset[int] = GM_BASS_PROGRAMS  # 0-based GM program numbers
+    bass_track_words: tuple[str, ...] = DEFAULT_BASS_WORDS
+    channels: Mapping[int, Route] = field(default_factory=dict)  # 1-based channel -> route
+    tracks: Mapping[str, Route] = field(default_factory=dict)  # lower-case name -> route
+
+    @classmethod
+    def from_dict(cls, table: Mapping[str, Any]) -> RoutingConfig:
+        """From the ``[routing]`` table of the config file."""
+        known = {"drum_channels", "bass_programs", "bass_track_words", "channels", "tracks"}
+        unknown = set(table) - known
+        if unknown:
+            raise ConfigError(f"[routing]: unknown key(s) {', '.join(sorted(unknown))}")
+        base = cls()
+        drum = frozenset(_channel_list(table.get("drum_channels", sorted(base.drum_channels))))
+        progs = table.get("bass_programs", sorted(base.bass_programs))
+        if not all(isinstance(p, int) and 0 <= p <= 127 for p in progs):
+            raise ConfigError("[routing] bass_programs: integers 0-127 (GM programs, 0-based)")
+        words = tuple(str(w).lower() for w in table.get("bass_track_words", base.bass_track_words))
+        chans: dict[int, Route] = {}
+        for k, v in dict(table.get("channels", {})).items():
+            (ch,) = _channel_list([int(k)] if str(k).isdigit() else [k])
+            chans[ch] = _target(v, f"[routing.channels] {k}")
+        tracks = {
+            str(k).lower(): _target(v, f"[routing.tracks] {k!r}")
+            for k, v in dict(table.get("tracks", {})).items()
+        }
+        return cls(drum, frozenset(progs), words, chans, tracks)
+
+    def with_overrides(
+        self,
+        *,
+        bass_channels: Iterable[int] = (),
+        drum_channels: Iterable[int] = (),
+        bass_tracks: Iterable[str] = (),
+        ignore_tracks: Iterable[str] = (),
+    ) -> RoutingConfig:
+        """A copy with CLI flags applied on top (flags win over the file)."""
+        chans = dict(self.channels)
+        for ch in _channel_list(bass_channels):
+            chans[ch] = "bass"
+        for ch in _channel_list(drum_channels):
+            chans[ch] = "drums"
+        tracks = dict(self.tracks)
+        tracks.update({n.lower(): "bass" for n in bass_tracks})
+        tracks.update({n.lower(): None for n in ignore_tracks})
+        return RoutingConfig(
+            self.drum_channels, self.bass_programs, self.bass_track_words, chans, tracks
+        )
+
+
+def _channel_list(values: Iterable[Any]) -> list[int]:
+    out = []
+    for v in values:
+        if not isinstance(v, int) or not 1 <= v <= 16:
+            raise ConfigError(f"MIDI channel must be 1-16, got {v!r}")
+        out.append(v)
+    return out
+
+
+def _target(value: Any, where: str) -> Route:
+    if not isinstance(value, str) or value.lower() not in _TARGETS:
+        raise ConfigError(f"{where}: must be one of 'bass', 'drums', 'none', got {value!r}")
+    return _TARGETS[value.lower()]
+
+
+def looks_like_bass(name: str, words: Iterable[str] = DEFAULT_BASS_WORDS) -> bool:
+    """True if a track name reads as a bass part ("Bass", "Walking bass", "Contrabass")."""
+    low = name.lower()
+    if any(w in low for w in DEFAULT_NOT_BASS_WORDS):
+        return False
+    tokens = re.split(r"[^a-z]+", low)
+    return any(w in tokens or (len(w) > 4 and w in low) for w in words)
+
+
+class Router:
+    """Stateful router: remembers the program in force per (source, channel).
+
+    The source is the track index for files and the sender id for network
+    input.  Events must be fed in time order (program changes take effect for
+    the notes after them).
+    """
+
+    def __init__(
+        self, config: RoutingConfig | None = None, track_names: Mapping[int, str] | None = None
+    ) -> None:
+        self.config = config or RoutingConfig()
+        self.track_names = dict(track_names or {})
+        self._programs: dict[tuple[int | None, int], int] = {}
+        self.counts: Counter[tuple[int | None, int, str]] = Counter()
+
+    @classmethod
+    def for_session(cls, session: Any, config: RoutingConfig | None = None) -> Router:
+        """A router for a :class:`virja.midifile.MidiSession` (knows its track names)."""
+        return cls(config, {t.index: t.name for t in session.tracks})
+
+    def _source(self, event: Event) -> int | None:
+        track = getattr(event, "track", None)
+        return track if track is not None else getattr(event, "sender", None)
+
+    def route(self, event: Event) -> Route:
+        """The performer of a note event; None for anything not the band's."""
+        if isinstance(event, ProgramChange):
+            self._programs[(self._source(event), event.channel)] = event.program
+            return None
+        if not isinstance(event, NoteOn | NoteOff):
+            return None
+        route = self._decide(event)
+        if isinstance(event, NoteOn):
+            track = getattr(event, "track", None)
+            self.counts[(track, event.channel, route or "none")] += 1
+        return route
+
+    def _decide(self, event: NoteOn | NoteOff) -> Route:
+        cfg = self.config
+        track = event.track
+        if track is not None and track in self.track_names:
+            name = self.track_names[track].lower()
+            if name in cfg.tracks:
+                return cfg.tracks[name]
+        channel_1 = event.channel + 1
+        if channel_1 in cfg.channels:
+            return cfg.channels[channel_1]
+        if channel_1 in cfg.drum_channels:
+            return "drums"
+        program = self._programs.get((self._source(event), event.channel))
+        if program is not None:
+            return "bass" if program in cfg.bass_programs else None
+        if track is not None and looks_like_bass(
+            self.track_names.get(track, ""), cfg.bass_track_words
+        ):
+            return "bass"
+        return None
+
+    def report(self) -> list[str]:
+        """One line per (track, channel): how many notes went to whom."""
+        lines = []
+        for (track, channel, route), n in sorted(
+            self.counts.items(), key=lambda kv: (kv[0][0] if kv[0][0] is not None else -1, kv[0][1])
+        ):
+            where = f"channel {channel + 1}"
+            if track is not None:
+                name = self.track_names.get(track, "")
+                where = f"track {track}" + (f" {name!r}" if name else "") + f", {where}"
+            who = {"bass": "bassist", "drums": "drummer"}.get(route, "not the band's (ignored)")
+            lines.append(f"{where}: {n} notes -> {who}")
+        return lines
+
+
+def route_all(events: Iterable[Event], router: Router) -> list[tuple[Performer, NoteOn | NoteOff]]:
+    """The band's note events with their performer, in the given (time) order."""
+    out: list[tuple[Performer, NoteOn | NoteOff]] = []
+    for ev in events:
+        who = router.route(ev)
+        if who is not None and isinstance(ev, NoteOn | NoteOff):
+            out.append((who, ev))
+    return out

@@ -2,7 +2,7 @@
 
 ```toml
 [routing]      # virja.routing.RoutingConfig
-[planner]      # virja.plan (tunings, tables)
+[plan]         # virja.plan (tunings, tables)
 [render]       # size, fps, camera
 ```
 
@@ -18,7 +18,7 @@ from typing import Any
 
 from virja.errors import ConfigError, InputFileError
 
-KNOWN_TABLES = frozenset({"routing", "planner", "render", "serve", "jam", "motion"})
+KNOWN_TABLES = frozenset({"routing", "plan", "render", "serve", "jam", "motion"})
 
 
 def load_config(path: str | Path | None) -> dict[str, Any]:

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -55,7 +55,7 @@ def sphere_mesh(rings: int = 8, segments: int = 12) -> F32:
     for i in range(rings):
         for j in range(segments):
             a, b, c, d = p(i, j), p(i + 1, j), p(i, j + 1), p(i + 1, j + 1)
-            for v in (a, b, c, c, b, d):
+            for v in (a, c, b, c, d, b):  # counter-clockwise seen from outside
                 tris.append([*v, *v])
     return np.asarray(tris, dtype=np.float32)
 
@@ -97,7 +97,7 @@ def _basis_from_y(axis: F64) -> F64:
     return np.stack([x, y, z], axis=2)  # columns x, y, z
 
 
-def segment_transforms(a: F64, b: F64, radius: F64) -> F64:
+def segment_transforms(a: ArrayLike, b: ArrayLike, radius: ArrayLike) -> F64:
     """Unit-cylinder instances spanning points ``a`` -> ``b`` (n, 3) with radii (n,)."""
     a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
     b = np.asarray(b, dtype=np.float64).reshape(-1, 3)
@@ -112,7 +112,7 @@ def segment_transforms(a: F64, b: F64, radius: F64) -> F64:
     return m
 
 
-def sphere_transforms(center: F64, radius: F64) -> F64:
+def sphere_transforms(center: ArrayLike, radius: ArrayLike) -> F64:
     """Unit-sphere instances at ``center`` (n, 3) with radii (n,)."""
     c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
     r = np.broadcast_to(np.asarray(radius, dtype=np.float64), (c.shape[0],))
@@ -123,7 +123,7 @@ def sphere_transforms(center: F64, radius: F64) -> F64:
     return m
 
 
-def disc_transforms(center: F64, normal: F64, radius: F64, thickness: F64) -> F64:
+def disc_transforms(center: ArrayLike, normal: ArrayLike, radius: ArrayLike, thickness: ArrayLike) -> F64:
     """Flat cylinders (drum heads, cymbals) centred at ``center``, axis ``normal``."""
     c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normal, dtype=np.float64).reshape(-1, 3)
@@ -132,11 +132,11 @@ def disc_transforms(center: F64, normal: F64, radius: F64, thickness: F64) -> F6
     return segment_transforms(c - n * (t / 2)[:, None], c + n * (t / 2)[:, None], radius)
 
 
-def box_transforms(center: F64, size: F64, rotation: F64 | None = None) -> F64:
+def box_transforms(center: ArrayLike, size: ArrayLike, rotation: ArrayLike | None = None) -> F64:
     """Box instances: centre (n, 3), full size (n, 3), optional rotation (n, 3, 3)."""
     c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
     s = np.asarray(size, dtype=np.float64).reshape(-1, 3)
-    rot = np.broadcast_to(np.eye(3), (c.shape[0], 3, 3)) if rotation is None else rotation
+    rot = np.broadcast_to(np.eye(3), (c.shape[0], 3, 3)) if rotation is None else np.asarray(rotation)
     m = np.zeros((c.shape[0], 4, 4))
     m[:, :3, :3] = rot * s[:, None, :]
     m[:, :3, 3] = c
@@ -144,7 +144,7 @@ def box_transforms(center: F64, size: F64, rotation: F64 | None = None) -> F64:
     return m
 
 
-def pack_instances(models: F64, colors: F64) -> F32:
+def pack_instances(models: F64, colors: ArrayLike) -> F32:
     """(n, 20) float32 rows: the column-major matrix then RGBA."""
     n = models.shape[0]
     out = np.empty((n, 20), dtype=np.float32)

@@ -9,11 +9,12 @@ knows nothing of notes or skeletons: ``virja.render.scene`` turns a
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import moderngl
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from virja.render.camera import Camera
 from virja.render.meshes import MESHES, pack_instances
@@ -22,6 +23,7 @@ from virja.render.shaders import load_program
 F64 = NDArray[np.float64]
 
 BACKGROUND = (0.055, 0.06, 0.085)
+_EMPTY = np.zeros((0, 20), dtype=np.float32)
 
 
 @dataclass
@@ -30,8 +32,11 @@ class DrawList:
 
     models: dict[str, list[F64]] = field(default_factory=dict)
     colors: dict[str, list[F64]] = field(default_factory=dict)
+    _frozen: dict[str, NDArray[np.float32]] | None = None
 
-    def add(self, kind: str, models: F64, color: F64 | tuple[float, ...]) -> None:
+    def add(self, kind: str, models: ArrayLike, color: ArrayLike) -> None:
+        if self._frozen is not None:
+            raise RuntimeError("this DrawList is frozen")
         if kind not in MESHES:
             raise ValueError(f"unknown mesh kind {kind!r}; known: {sorted(MESHES)}")
         m = np.asarray(models, dtype=np.float64).reshape(-1, 4, 4)
@@ -43,9 +48,17 @@ class DrawList:
         self.colors.setdefault(kind, []).append(np.array(c))
 
     def packed(self, kind: str) -> NDArray[np.float32]:
+        """(n, 20) float32 instance rows of ``kind``; cached once :meth:`freeze` is called."""
+        if self._frozen is not None:
+            return self._frozen.get(kind, _EMPTY)
         if kind not in self.models:
-            return np.zeros((0, 20), dtype=np.float32)
+            return _EMPTY
         return pack_instances(np.concatenate(self.models[kind]), np.concatenate(self.colors[kind]))
+
+    def freeze(self) -> DrawList:
+        """Pack once and reuse (for the static stage and instruments)."""
+        self._frozen = {k: self.packed(k) for k in self.models}
+        return self
 
     def count(self) -> int:
         return sum(sum(len(m) for m in ms) for ms in self.models.values())
@@ -80,8 +93,14 @@ class Renderer:
             ],
         )
 
-    def draw(self, draw_list: DrawList, camera: Camera, fbo: moderngl.Framebuffer) -> None:
-        """Clear ``fbo`` and draw every instance as seen by ``camera``."""
+    def draw(
+        self,
+        draw_list: DrawList | Sequence[DrawList],
+        camera: Camera,
+        fbo: moderngl.Framebuffer,
+    ) -> None:
+        """Clear ``fbo`` and draw every instance of the list(s) as seen by ``camera``."""
+        lists = [draw_list] if isinstance(draw_list, DrawList) else list(draw_list)
         w, h = fbo.size
         fbo.use()
         self.ctx.viewport = (0, 0, w, h)
@@ -96,7 +115,8 @@ class Renderer:
         self._set("u_spot_pos", (0.0, 3.2, 1.6))
         self._set("u_fog_color", BACKGROUND)
         for kind in MESHES:
-            data = draw_list.packed(kind)
+            parts = [d.packed(kind) for d in lists]
+            data = parts[0] if len(parts) == 1 else np.concatenate(parts)
             n = len(data)
             if n == 0:
                 continue

@@ -1,0 +1,166 @@
+"""Render a MIDI file or a pcap recording to PNG frames or a video with sound.
+
+The notes are revealed to the scheduler a beat ahead (--lookahead-beats), as a
+performance generator would send them, and the same code as the live daemon
+plans and animates them; frames step exactly 1/fps.  OUT is a folder (PNG
+frames), a NAME.png (numbered PNGs beside it, or one frame with --at), or a
+video (.mp4, .mkv, .mov: H.264, with an AAC track rendered by fluidsynth from
+the same notes unless --no-audio).
+
+examples:
+  virja render virja/demo/blues.mid --out out/demo.mp4
+  virja render song.mid --out frames/ --size 640x360 --fps 20
+  virja render song.mid --out snare.png --at 3.2 --camera drums
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from virja.cli.common import ProgressBar, add_routing_arguments, make_router, open_plan_log
+from virja.errors import ConfigError, InputFileError
+from virja.render.camera import PRESETS
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "input", metavar="INPUT", help="a MIDI file (.mid) or an RMCP recording (.pcap, .pcapng)"
+    )
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="OUT",
+        help="folder, NAME.png, or video file (.mp4/.mkv/.mov)",
+    )
+    p.add_argument(
+        "--size", default="1280x720", metavar="WxH", help="frame size (default 1280x720)"
+    )
+    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument(
+        "--camera", choices=sorted(PRESETS), default="front", help="camera preset (default front)"
+    )
+    p.add_argument(
+        "--lookahead-beats",
+        type=float,
+        default=1.0,
+        metavar="B",
+        help="notes are known B beats ahead (default 1)",
+    )
+    p.add_argument("--no-audio", action="store_true", help="make a silent video")
+    p.add_argument(
+        "--soundfont", metavar="FILE.sf2", help="General MIDI soundfont for the audio track"
+    )
+    p.add_argument(
+        "--at",
+        type=float,
+        metavar="SECONDS",
+        help="render only the frame at this time (with a .png OUT)",
+    )
+    p.add_argument(
+        "--start",
+        type=float,
+        metavar="SECONDS",
+        help="first frame time (default: early enough for the first motion)",
+    )
+    p.add_argument(
+        "--end", type=float, metavar="SECONDS", help="last frame time (default: the end plus 1.5 s)"
+    )
+    p.add_argument("--samples", type=int, default=4, help="multisampling (1 = off; default 4)")
+    p.add_argument(
+        "--plan-log", metavar="FILE.jsonl", help="also write the plan, one JSON object per note"
+    )
+    p.add_argument(
+        "--bvh", metavar="OUT.bvh", help="also export the band's performed motion as BVH"
+    )
+    add_routing_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    from virja.input import load_performance_input
+
+    if args.fps <= 0 or args.fps > 240:
+        raise ConfigError(f"--fps must be in (0, 240], got {args.fps}")
+    if args.lookahead_beats < 0:
+        raise ConfigError("--lookahead-beats must be >= 0")
+    from virja.render.offline import OutputSpec, parse_size
+
+    size = parse_size(args.size)
+    out = OutputSpec.from_path(args.out)
+    if args.at is not None and out.kind != "png":
+        raise ConfigError("--at renders one frame: give --out NAME.png")
+    src = load_performance_input(Path(args.input), args, lookahead_beats=args.lookahead_beats)
+    for line in src.report:
+        print(line)
+    if src.note_count == 0:
+        raise InputFileError(args.input, "no notes for the band (bass or drums) in this input")
+    return render_input(src, args, size, out)
+
+
+def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], out: object) -> int:
+    """Shared by `render` and `replay --out`: plan, animate, draw, encode."""
+    from virja.input import PerformanceInput
+    from virja.motion.band import BandAnimator
+    from virja.plan.config import load_plan_config
+    from virja.plan.planner import OnlinePlanner
+    from virja.render.offline import OutputSpec, render_offline
+    from virja.render.video import make_audio_track, temp_workdir
+    from virja.session import Performance, RevealFeeder
+
+    assert isinstance(src, PerformanceInput) and isinstance(out, OutputSpec)
+    plan_log = open_plan_log(args.plan_log)
+    planner = OnlinePlanner(load_plan_config(args.config), tempo=src.tempo)
+    animator = BandAnimator()
+    perf = Performance(
+        router=make_router(args, src.midi), planner=planner, animator=animator, plan_log=plan_log
+    )
+    feeder = RevealFeeder(src.schedule)
+    t0, t1 = src.default_span()
+    if args.start is not None:
+        t0 = args.start
+    if args.end is not None:
+        t1 = args.end
+    if args.at is not None:
+        t0 = t1 = args.at
+        # everything known before the frame must have been fed: start the feeder there
+    if t1 < t0:
+        raise ConfigError(f"nothing to render: end {t1:.3f} s is before start {t0:.3f} s")
+    with temp_workdir() as tmp:
+        audio = None
+        if out.kind == "video" and not args.no_audio:
+            audio, why_not = make_audio_track(
+                src.sound_events, src.sound_origin_s, Path(tmp), args.soundfont
+            )
+            if why_not:
+                print(f"virja: {why_not}", file=sys.stderr)
+        progress = ProgressBar("rendering") if out.kind != "png" or args.at is None else None
+        result = render_offline(
+            perf,
+            feeder,
+            t0_s=t0,
+            t1_s=t1,
+            fps=args.fps,
+            size=size,
+            out=out,
+            camera=PRESETS[args.camera],
+            audio=audio,
+            audio_offset_s=src.sound_origin_s - t0,
+            samples=args.samples,
+            progress=progress,
+        )
+    if plan_log is not None:
+        plan_log.close()
+    if args.bvh:
+        from virja.motion.export import performance_to_bvh
+
+        performance_to_bvh(animator, t0, t1, args.fps, Path(args.bvh))
+        print(f"wrote {args.bvh}")
+    rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
+    where = out.path if out.kind != "png" or len(result.outputs) != 1 else result.outputs[0]
+    print(
+        f"wrote {result.frames} frames ({t0:.2f} s to {t1:.2f} s at {args.fps:g} fps) to {where} "
+        f"in {result.seconds:.1f} s ({rate:.1f} frames/s); "
+        f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
+    )
+    return 0

@@ -1,0 +1,119 @@
+"""Replay a pcap recording of RMCP traffic through the same receiver and scheduler.
+
+The recorded datagrams are fed at their recorded receive times (a virtual
+clock), so --plan-log gives the plan the live daemon made.  With --out the
+band is rendered headless to a video or PNG frames (as `virja render`); with
+--headless nothing is drawn (plan log and summary only, as fast as possible);
+otherwise it plays in a window in real time.  Reads pcaps written by
+`virja serve --record`, tcpdump or Wireshark (pcap and pcapng).
+
+examples:
+  virja replay session.pcap --headless --plan-log replay.jsonl
+  virja replay session.pcap --out session.mp4
+  virja replay capture.pcapng --port 50600
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+from virja.cli.common import add_routing_arguments, make_router, open_plan_log
+from virja.errors import ConfigError, InputFileError
+from virja.render.camera import PRESETS
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("input", metavar="FILE.pcap", help="a pcap or pcapng recording")
+    p.add_argument(
+        "--port", type=int, default=None, help="RMCP UDP port in the capture (default 50500)"
+    )
+    p.add_argument("--key-file", metavar="FILE", help="HMAC key, as the live daemon had it")
+    p.add_argument(
+        "--plan-log", metavar="FILE.jsonl", help="write the plan, one JSON object per note"
+    )
+    p.add_argument("--headless", action="store_true", help="draw nothing: plan and summary only")
+    p.add_argument(
+        "--out", metavar="OUT", help="render to a video (.mp4/.mkv/.mov), a folder or NAME.png"
+    )
+    p.add_argument("--size", default="1280x720", metavar="WxH")
+    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--camera", choices=sorted(PRESETS), default="front")
+    p.add_argument("--no-audio", action="store_true")
+    p.add_argument("--soundfont", metavar="FILE.sf2")
+    p.add_argument("--samples", type=int, default=4)
+    add_routing_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    from virja.cli.common import routing_config
+    from virja.input import pcap_input
+
+    if args.port is not None and not 1 <= args.port <= 65535:
+        raise ConfigError(f"--port must be 1-65535, got {args.port}")
+    src = pcap_input(Path(args.input), routing_config(args), port=args.port, key_file=args.key_file)
+    for line in src.report:
+        print(line)
+    if not src.schedule:
+        raise InputFileError(args.input, "the recording holds no valid RMCP events")
+    if args.out:
+        from virja.cli.cmd_render import render_input
+        from virja.render.offline import OutputSpec, parse_size
+
+        args.at = args.start = args.end = None
+        args.bvh = None
+        return render_input(src, args, parse_size(args.size), OutputSpec.from_path(args.out))
+    return play(src, args)
+
+
+def play(src: object, args: argparse.Namespace) -> int:
+    from virja.input import PerformanceInput
+    from virja.motion.band import BandAnimator
+    from virja.plan.config import load_plan_config
+    from virja.plan.planner import OnlinePlanner
+    from virja.session import Performance, RevealFeeder
+
+    assert isinstance(src, PerformanceInput)
+    plan_log = open_plan_log(args.plan_log)
+    perf = Performance(
+        router=make_router(args),
+        planner=OnlinePlanner(load_plan_config(args.config)),
+        animator=None if args.headless else BandAnimator(),
+        plan_log=plan_log,
+    )
+    feeder = RevealFeeder(src.schedule)
+    t0, t1 = src.default_span()
+    try:
+        if args.headless:
+            # virtual clock: jump from reveal to reveal, committing at each
+            for r in src.schedule:
+                feeder.until(perf, r.at_s)
+                perf.advance(r.at_s)
+            feeder.until(perf, math.inf)
+        else:
+            from virja.render.live import LiveView
+            from virja.render.offline import parse_size
+
+            view = LiveView(parse_size(args.size), title=f"virja replay {Path(args.input).name}")
+            wall0 = time.perf_counter()
+            try:
+                while not view.closed:
+                    t = t0 + (time.perf_counter() - wall0)
+                    if t > t1:
+                        break
+                    feeder.until(perf, t)
+                    perf.advance(t)
+                    view.frame(perf, t)
+            finally:
+                view.close()
+        perf.finish()
+    finally:
+        if plan_log is not None:
+            plan_log.close()
+    print(
+        f"replayed {len(src.schedule)} events: {perf.counts['planned']} notes planned "
+        f"({perf.counts['planned_late']} late), {perf.counts['notes_not_the_bands']} not the band's"
+    )
+    return 0

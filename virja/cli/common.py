@@ -1,0 +1,105 @@
+"""Options and set-up shared by the subcommands that play a performance."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import IO, Any
+
+from virja.config import load_config, section
+from virja.routing import Router, RoutingConfig
+
+
+def add_routing_arguments(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("routing (see docs/routing.md; flags win over --config)")
+    g.add_argument(
+        "--config", metavar="FILE.toml", help="configuration file ([routing], [plan], ...)"
+    )
+    g.add_argument(
+        "--bass-channel",
+        type=int,
+        action="append",
+        default=[],
+        metavar="N",
+        help="MIDI channel (1-16) the bassist plays; repeatable",
+    )
+    g.add_argument(
+        "--drums-channel",
+        type=int,
+        action="append",
+        default=[],
+        metavar="N",
+        help="MIDI channel (1-16) the drummer plays; repeatable",
+    )
+    g.add_argument(
+        "--bass-track",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="track name the bassist plays; repeatable",
+    )
+    g.add_argument(
+        "--ignore-track",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="track name nobody plays; repeatable",
+    )
+
+
+def routing_config(args: argparse.Namespace, doc: dict[str, Any] | None = None) -> RoutingConfig:
+    doc = load_config(args.config) if doc is None else doc
+    base = RoutingConfig.from_dict(section(doc, "routing"))
+    return base.with_overrides(
+        bass_channels=args.bass_channel,
+        drum_channels=args.drums_channel,
+        bass_tracks=args.bass_track,
+        ignore_tracks=args.ignore_track,
+    )
+
+
+def make_router(args: argparse.Namespace, session: Any = None) -> Router:
+    cfg = routing_config(args)
+    if session is not None:
+        return Router.for_session(session, cfg)
+    return Router(cfg)
+
+
+def open_plan_log(path: str | None) -> IO[str] | None:
+    if not path:
+        return None
+    p = Path(path)
+    if p.parent and not p.parent.exists():
+        p.parent.mkdir(parents=True, exist_ok=True)
+    return p.open("w", encoding="utf-8", buffering=1)
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr (every 10 % when stderr is not a terminal)."""
+
+    def __init__(self, label: str, stream: IO[str] = sys.stderr) -> None:
+        self.label = label
+        self.stream = stream
+        self.tty = stream.isatty()
+        self._last_decile = -1
+
+    def __call__(self, done: int, total: int, elapsed_s: float) -> None:
+        frac = done / max(total, 1)
+        rate = done / elapsed_s if elapsed_s > 0 else 0.0
+        if self.tty:
+            bar = "#" * int(frac * 30)
+            self.stream.write(
+                f"\r{self.label} [{bar:<30}] {frac:4.0%} {done}/{total} frames, {rate:5.1f} fps"
+            )
+            if done == total:
+                self.stream.write("\n")
+            self.stream.flush()
+            return
+        decile = int(frac * 10)
+        if decile != self._last_decile:
+            self._last_decile = decile
+            self.stream.write(
+                f"{self.label}: {frac:4.0%} ({done}/{total} frames, {rate:.1f} fps)\n"
+            )
+            self.stream.flush()

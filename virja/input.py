@@ -1,0 +1,157 @@
+"""Offline inputs as a reveal schedule: MIDI files and pcap recordings of RMCP.
+
+Both become a :class:`PerformanceInput`: the events with the session time at
+which each becomes known (a file's notes a beat ahead; a recording's at their
+recorded receive times, through the same receiver as the live daemon), the
+tempo, the events to sound in the audio track, and a report for the CLI.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from virja.errors import InputFileError
+from virja.events import Event, NoteOff, NoteOn
+from virja.midifile import MidiSession, read_midi
+from virja.routing import Router, RoutingConfig
+from virja.session import Reveal, reveal_schedule
+from virja.tempo import Tempo
+
+MIDI_SUFFIXES = frozenset({".mid", ".midi", ".smf", ".kar"})
+PCAP_SUFFIXES = frozenset({".pcap", ".pcapng", ".cap"})
+TAIL_S = 1.5  # frames after the last note, so the last strokes finish and ring
+
+
+@dataclass
+class PerformanceInput:
+    kind: str  # "midi" or "pcap"
+    path: Path
+    schedule: list[Reveal]
+    tempo: Tempo | None
+    sound_events: list[Event]
+    sound_origin_s: float  # session time of the audio track's t = 0
+    note_count: int
+    report: list[str] = field(default_factory=list)
+    midi: MidiSession | None = None
+    receiver_stats: dict[str, Any] = field(default_factory=dict)
+
+    def default_span(self) -> tuple[float, float]:
+        """From the first reveal (early enough for the first motion) to the end plus a tail."""
+        if not self.schedule:
+            return (0.0, 0.0)
+        first = min(r.at_s for r in self.schedule)
+        last_event = max(r.event.time_s for r in self.schedule)
+        start = min(first, min(r.event.time_s for r in self.schedule))
+        return (start, last_event + TAIL_S)
+
+
+def input_kind(path: Path) -> str:
+    suffix = path.suffix.lower()
+    if suffix in MIDI_SUFFIXES:
+        return "midi"
+    if suffix in PCAP_SUFFIXES:
+        return "pcap"
+    try:
+        head = path.read_bytes()[:4]
+    except OSError as exc:
+        raise InputFileError(path, f"cannot read: {exc.strerror or exc}") from exc
+    if head == b"MThd":
+        return "midi"
+    if head in (
+        b"\xd4\xc3\xb2\xa1",
+        b"\xa1\xb2\xc3\xd4",
+        b"\x4d\x3c\xb2\xa1",
+        b"\xa1\xb2\x3c\x4d",
+        b"\x0a\x0d\x0d\x0a",
+    ):
+        return "pcap"
+    raise InputFileError(path, "neither a MIDI file nor a pcap recording (by name or content)")
+
+
+def _routing(args: argparse.Namespace) -> RoutingConfig:
+    from virja.cli.common import routing_config
+
+    return routing_config(args)
+
+
+def load_performance_input(
+    path: Path, args: argparse.Namespace, *, lookahead_beats: float = 1.0
+) -> PerformanceInput:
+    kind = input_kind(path)
+    if kind == "midi":
+        return midi_input(path, _routing(args), lookahead_beats)
+    return pcap_input(
+        path,
+        _routing(args),
+        port=getattr(args, "port", None),
+        key_file=getattr(args, "key_file", None),
+    )
+
+
+def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> PerformanceInput:
+    session = read_midi(path)
+    dry = Router.for_session(session, routing)
+    notes = sum(1 for e in session.events if isinstance(e, NoteOn) and dry.route(e) is not None)
+    events: list[Event] = [*session.events, *session.beats]
+    events.sort(key=lambda e: e.time_s)
+    report = [f"{path}: {len(session.tracks)} tracks, {session.duration_s:.1f} s", *dry.report()]
+    return PerformanceInput(
+        kind="midi",
+        path=path,
+        schedule=reveal_schedule(events, session.tempo_map, lookahead_beats),
+        tempo=session.tempo_map,
+        sound_events=list(session.events),
+        sound_origin_s=0.0,
+        note_count=notes,
+        report=report,
+        midi=session,
+    )
+
+
+def pcap_input(
+    path: Path, routing: RoutingConfig, *, port: int | None = None, key_file: str | None = None
+) -> PerformanceInput:
+    from virja.rmcp import DEFAULT_PORT
+    from virja.rmcp.pcap import read_capture
+    from virja.rmcp.receiver import Receiver, ReceiverConfig
+    from virja.rmcp.signing import load_key
+
+    cap = read_capture(path, port=DEFAULT_PORT if port is None else port)
+    key = load_key(key_file) if key_file else None
+    receiver = Receiver(ReceiverConfig(key=key, answer_clock=False))
+    schedule: list[Reveal] = []
+    for dg in cap.datagrams:
+        receiver.receive_datagram(dg.payload, dg.src, now_us=dg.time_us)
+        for rec in receiver.drain_events():
+            schedule.append(Reveal(rec.arrival_s, rec.event))
+    dry = Router(routing)
+    notes = sum(
+        1 for r in schedule if isinstance(r.event, NoteOn) and dry.route(r.event) is not None
+    )
+    sound = sorted(
+        (r.event for r in schedule if isinstance(r.event, NoteOn | NoteOff)), key=lambda e: e.time_s
+    )
+    origin = sound[0].time_s if sound else 0.0
+    # no tempo up front: as live, the scheduler learns the tempo from BEAT messages
+    tempo: Tempo | None = None
+    stats = receiver.stats.as_dict()
+    report = [
+        f"{path}: {cap.packets} packets, {len(cap.datagrams)} RMCP datagrams, "
+        f"{stats['events']} events accepted, drops {stats['dropped'] or 'none'}",
+        *cap.warnings,
+        *dry.report(),
+    ]
+    return PerformanceInput(
+        kind="pcap",
+        path=path,
+        schedule=schedule,
+        tempo=tempo,
+        sound_events=list(sound),
+        sound_origin_s=origin,
+        note_count=notes,
+        report=report,
+        receiver_stats=stats,
+    )

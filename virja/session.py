@@ -1,0 +1,169 @@
+"""One performance: router -> planner -> animator, driven by a timer.
+
+``serve``, ``replay``, ``render`` and ``jam`` all build a :class:`Performance`
+and drive it the same way; only the timer differs (live: the session clock;
+offline: exact 1/fps steps):
+
+    perf.feed(event, now_s=t)      # as events arrive (or are revealed)
+    perf.advance(now_s=t)          # commit motions that have started
+    perf.pose(t)                   # what to draw at t
+
+The plan log (``--plan-log``) gets one JSON object per planned note, exactly
+as ``virja plan --json`` prints it, written and flushed as notes are committed.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections import Counter
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import IO, TYPE_CHECKING
+
+from virja.events import Beat, Event, NoteOff, NoteOn, Performer
+from virja.routing import Router
+from virja.tempo import Tempo
+
+if TYPE_CHECKING:
+    from virja.motion.band import BandAnimator
+    from virja.motion.pose import BandPose
+    from virja.plan.planner import OnlinePlanner
+    from virja.plan.types import PlannedNote
+
+log = logging.getLogger(__name__)
+
+
+class Performance:
+    """Routes events, plans motions, animates the band; counts what it did."""
+
+    def __init__(
+        self,
+        *,
+        router: Router,
+        planner: OnlinePlanner,
+        animator: BandAnimator | None = None,
+        plan_log: IO[str] | None = None,
+    ) -> None:
+        self.router = router
+        self.planner = planner
+        self.animator = animator
+        self.plan_log = plan_log
+        self.counts: Counter[str] = Counter()
+        self.planned: list[PlannedNote] = []
+        self.keep_planned = True
+
+    def feed(self, event: Event, *, now_s: float) -> Performer | None:
+        """An event has become known at ``now_s``; returns the performer it went to."""
+        if isinstance(event, Beat):
+            self._beat(event)
+            return None
+        performer = self.router.route(event)
+        if performer is not None:
+            self.feed_routed(performer, event, now_s=now_s)
+        elif isinstance(event, NoteOn):
+            self.counts["notes_not_the_bands"] += 1
+        return performer
+
+    def feed_routed(self, performer: Performer, event: Event, *, now_s: float) -> None:
+        """An event already routed (jam's keyboard split does its own routing)."""
+        if isinstance(event, NoteOn):
+            self.planner.add_note(performer, event, now_s=now_s)
+            self.counts[f"notes_{performer}"] += 1
+        elif isinstance(event, NoteOff):
+            add_off = getattr(self.planner, "add_note_off", None)
+            if add_off is not None:
+                add_off(performer, event, now_s=now_s)
+            if self.animator is not None:
+                note_off = getattr(self.animator, "note_off", None)
+                if note_off is not None:
+                    note_off(performer, event)
+        elif isinstance(event, Beat):
+            self._beat(event)
+
+    def _beat(self, beat: Beat) -> None:
+        self.planner.add_beat(beat)
+        if self.animator is not None:
+            self.animator.add_beat(beat)
+        self.counts["beats"] += 1
+
+    def advance(self, now_s: float) -> list[PlannedNote]:
+        """Commit the motions that have started by ``now_s``; log and animate them."""
+        return self._commit(self.planner.poll(now_s))
+
+    def finish(self) -> list[PlannedNote]:
+        """Commit everything still pending (end of a file or a replay)."""
+        return self._commit(self.planner.flush())
+
+    def _commit(self, notes: list[PlannedNote]) -> list[PlannedNote]:
+        for p in notes:
+            if self.animator is not None:
+                self.animator.add_planned(p)
+            if self.plan_log is not None:
+                self.plan_log.write(json.dumps(p.to_json()) + "\n")
+            if self.keep_planned:
+                self.planned.append(p)
+            self.counts["planned"] += 1
+            if p.late:
+                self.counts["planned_late"] += 1
+        if notes and self.plan_log is not None:
+            self.plan_log.flush()
+        return notes
+
+    def pose(self, time_s: float) -> BandPose:
+        if self.animator is None:
+            raise RuntimeError("this performance has no animator")
+        return self.animator.pose(time_s)
+
+
+@dataclass(frozen=True)
+class Reveal:
+    """An event and the session time at which it becomes known."""
+
+    at_s: float
+    event: Event
+
+
+def reveal_schedule(events: Iterable[Event], tempo: Tempo, lookahead_beats: float) -> list[Reveal]:
+    """File events revealed as a performance generator would send them.
+
+    Notes (on and off) and beats become known ``lookahead_beats`` beats before
+    their time, at the tempo in force then; controllers and program changes
+    likewise, so routing sees a program before the notes it governs.
+    """
+    out = [
+        Reveal(ev.time_s - lookahead_beats * tempo.seconds_per_beat_at(ev.time_s), ev)
+        for ev in events
+    ]
+    out.sort(key=lambda r: r.at_s)  # stable: simultaneous reveals keep file order
+    return out
+
+
+def frame_times(t0_s: float, t1_s: float, fps: float) -> Iterator[float]:
+    """The replay timer: frame i is at exactly t0 + i / fps, up to and including t1."""
+    if fps <= 0:
+        raise ValueError(f"fps must be > 0, got {fps}")
+    n = int((t1_s - t0_s) * fps + 1e-9) + 1
+    for i in range(max(n, 0)):
+        yield t0_s + i / fps
+
+
+class RevealFeeder:
+    """Feeds a reveal schedule into a performance as the timer passes each reveal."""
+
+    def __init__(self, schedule: list[Reveal]) -> None:
+        self.schedule = schedule
+        self.next = 0
+
+    def until(self, perf: Performance, now_s: float) -> int:
+        n = 0
+        while self.next < len(self.schedule) and self.schedule[self.next].at_s <= now_s:
+            r = self.schedule[self.next]
+            perf.feed(r.event, now_s=r.at_s)
+            self.next += 1
+            n += 1
+        return n
+
+    @property
+    def done(self) -> bool:
+        return self.next >= len(self.schedule)

@@ -17,8 +17,11 @@ out vec4 v_color;
 
 void main() {
     vec4 world = in_model * vec4(in_position, 1.0);
-    // normals through the inverse transpose; instances are affine with no shear
-    mat3 normal_matrix = transpose(inverse(mat3(in_model)));
+    // Normals through the inverse transpose.  Every instance is a rotation times a
+    // scale (orthogonal columns), whose inverse transpose is each column divided by
+    // its squared length: far cheaper per vertex than inverse() on llvmpipe.
+    mat3 m = mat3(in_model);
+    mat3 normal_matrix = mat3(m[0] / dot(m[0], m[0]), m[1] / dot(m[1], m[1]), m[2] / dot(m[2], m[2]));
     v_world = world.xyz;
     v_normal = normalize(normal_matrix * in_normal);
     v_color = in_color;

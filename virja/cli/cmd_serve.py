@@ -138,8 +138,7 @@ class Daemon:
             f"notes: {self.perf.counts['planned']} planned, {self.late_notes} arrived late "
             f"(played compressed), {self.perf.counts['notes_not_the_bands']} not the band's",
         ]
-        report = self.perf.planner.report()
-        summary = report.summary() if hasattr(report, "summary") else {}
+        summary = self.perf.planner.report.summary()
         if summary:
             lines.append("scheduler: " + ", ".join(f"{k} {v}" for k, v in summary.items()))
         if self.clock_client is not None:
@@ -197,17 +196,16 @@ async def serve(args: argparse.Namespace) -> int:
         from virja.render.live import LiveView
 
         view = LiveView(parse_size(args.size), title=f"virja serve {host}:{port}")
-    recorder = (
-        PcapWriter.open(
-            args.record, local=(host if host not in ("", "0.0.0.0", "::") else "127.0.0.1", port)
-        )
-        if args.record
-        else None
-    )
-    daemon = Daemon(perf=perf, receiver=receiver, clock=clock, recorder=recorder)
-    protocol = RmcpProtocol(receiver, clock, daemon.on_events, recorder=recorder)
+    daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
+    protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_listener(host, port, protocol, group=args.group)
     bound = transport.get_extra_info("sockname")
+    if args.record:
+        # the recording names the address and port actually bound (port 0 picks one)
+        wildcard = bound[0] in ("0.0.0.0", "::")
+        local_host = ("::1" if ":" in bound[0] else "127.0.0.1") if wildcard else bound[0]
+        recorder = PcapWriter.open(args.record, local=(local_host, bound[1]))
+        protocol.recorder = daemon.recorder = recorder
     print(
         f"virja serve: listening on {bound[0]}:{bound[1]}"
         + (f", group {args.group}" if args.group else ""),
@@ -254,8 +252,8 @@ async def serve(args: argparse.Namespace) -> int:
         transport.close()
         daemon.tick()
         perf.finish()  # notes planned ahead of the stop are logged too, as replay logs them
-        if recorder is not None:
-            recorder.close()
+        if daemon.recorder is not None:
+            daemon.recorder.close()
         if plan_log is not None:
             plan_log.close()
         if view is not None:

@@ -16,10 +16,10 @@ from numpy.typing import NDArray
 
 @dataclass(frozen=True)
 class Camera:
-    target: tuple[float, float, float] = (0.0, 0.95, 0.0)
+    target: tuple[float, float, float] = (0.0, 0.85, 0.1)
     yaw_deg: float = 0.0  # 0: looking from the audience (+z) towards the stage
     pitch_deg: float = 12.0  # above the horizon
-    distance_m: float = 5.2
+    distance_m: float = 4.1
     fov_deg: float = 42.0
     near_m: float = 0.05
     far_m: float = 60.0

@@ -122,7 +122,7 @@ def render_offline(
             if writer is not None:
                 writer.write(frame)
             else:
-                path = out.frame_path(i)
+                path = out.path if out.kind == "png" and len(times) == 1 else out.frame_path(i)
                 write_png(path, frame)
                 outputs.append(path)
             if progress is not None:

@@ -29,7 +29,7 @@ from virja.render.renderer import DrawList
 F64 = NDArray[np.float64]
 
 # linear RGB, alpha = shininess
-FLOOR = (0.13, 0.085, 0.06, 0.15)
+FLOOR = (0.075, 0.05, 0.04, 0.15)
 RUG = (0.32, 0.06, 0.07, 0.0)
 SHELL = (0.45, 0.05, 0.06, 0.55)
 HEAD = (0.86, 0.84, 0.78, 0.1)
@@ -270,13 +270,27 @@ def _figure(dl: DrawList, fig: FigurePose, shirt: tuple[float, ...]) -> None:
     parents = np.asarray(fig.parents)
     radii = np.asarray(fig.radii, dtype=np.float64)
     names = list(fig.names)
-    child = np.nonzero(parents >= 0)[0]
+    is_head = np.array([n.lower() in ("head", "headend") for n in names])
+    child = np.nonzero((parents >= 0) & ~is_head)[0]
     colors = np.array([_limb_color(names[i], shirt) for i in child])
     dl.add("cylinder", segment_transforms(pos[parents[child]], pos[child], radii[child]), colors)
-    joint_colors = np.array([_limb_color(n, shirt) for n in names])
-    head = np.array(["head" in n.lower() for n in names])
-    jr = np.where(head, np.maximum(radii, 0.1), radii * 1.05)
-    dl.add("sphere", sphere_transforms(pos, jr), joint_colors)
+    joints = np.nonzero(~is_head)[0]
+    joint_colors = np.array([_limb_color(names[i], shirt) for i in joints])
+    dl.add("sphere", sphere_transforms(pos[joints], radii[joints] * 1.05), joint_colors)
+    if "Head" in names and "HeadEnd" in names:
+        # the head: one sphere between the base of the skull and its top, a nose to show where it looks
+        a, b = pos[names.index("Head")], pos[names.index("HeadEnd")]
+        centre = (a + b) / 2
+        dl.add("sphere", sphere_transforms([centre], 0.105), SKIN)
+        rot = np.asarray(fig.rotations)[names.index("Head")]
+        forward = _quat_rotate(rot, np.array([0.0, 0.0, 1.0]))
+        dl.add("sphere", sphere_transforms([centre + forward * 0.1], 0.022), SKIN)
+
+
+def _quat_rotate(q: F64, v: F64) -> F64:
+    """Rotate ``v`` (3,) by the unit quaternion ``q`` (w, x, y, z)."""
+    w, u = q[0], q[1:]
+    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
 
 
 def _limb_color(name: str, shirt: tuple[float, ...]) -> tuple[float, ...]:

@@ -1,0 +1,316 @@
+"""Benchmarks: figures printed by ``virja bench``, never asserted in tests.
+
+Each function measures one thing on this machine and returns plain numbers;
+:func:`run_all` gathers them with the targets of the issues, so each figure
+can be shown as a ratio to its target (machines here are noisy; ratios and
+medians travel better than single times).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import platform
+import socket
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from virja.events import NoteOn
+from virja.midifile import read_midi
+
+
+@dataclass(frozen=True)
+class Figure:
+    key: str
+    value: float
+    unit: str
+    target: float
+    higher_is_better: bool
+    note: str = ""
+
+    @property
+    def ratio(self) -> float:
+        """Figure over target when higher is better, target over figure otherwise (>= 1 meets it)."""
+        if self.value <= 0:
+            return 0.0 if self.higher_is_better else float("inf")
+        return self.value / self.target if self.higher_is_better else self.target / self.value
+
+
+def demo_path() -> str:
+    """The bundled demo session (inside the package, so installed copies have it)."""
+    return str(Path(__file__).resolve().parent / "demo" / "blues.mid")
+
+
+def machine() -> dict[str, Any]:
+    cpu = platform.processor() or ""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "system": f"{platform.system()} {platform.release()}",
+    }
+
+
+# -- RMCP ---------------------------------------------------------------------
+
+
+def _datagrams(n: int, senders: int = 4) -> list[bytes]:
+    from virja.rmcp import wire
+
+    base_us = 1_700_000_000_000_000
+    out = []
+    for i in range(n):
+        sender = 1 + i % senders
+        seq = i // senders
+        out.append(bytes(wire.midi(sender, seq, base_us + i * 1000, bytes([0x99, 38, 100]))))
+    return out
+
+
+def rmcp_decode_rate(n: int = 40_000) -> float:
+    """Datagrams decoded, validated and queued per second (one core, no sockets)."""
+    from virja.rmcp.receiver import Receiver, ReceiverConfig
+
+    data = _datagrams(n)
+    receiver = Receiver(ReceiverConfig(horizon_s=1e9, lateness_s=1e9))
+    now_us = 1_700_000_000_000_000
+    addr = ("127.0.0.1", 50501)
+    start = time.perf_counter()
+    for d in data:
+        receiver.receive_datagram(d, addr, now_us=now_us)
+        receiver.drain_events()
+    elapsed = time.perf_counter() - start
+    return n / elapsed
+
+
+def rmcp_latency_ms(n: int = 1500, rate_hz: float = 1000.0) -> tuple[float, float]:
+    """Loopback send -> received -> routed -> planned, p50 and p99 in ms.
+
+    A client socket sends note datagrams (a beat ahead on the session clock) to
+    the daemon's protocol on 127.0.0.1; the time from ``sendto`` to the planner
+    holding the note in its plan is measured in one process on one clock.
+    """
+    return asyncio.run(_latency(n, rate_hz))
+
+
+async def _latency(n: int, rate_hz: float) -> tuple[float, float]:
+    from virja.clock import SessionClock
+    from virja.plan.planner import OnlinePlanner
+    from virja.rmcp import wire
+    from virja.rmcp.receiver import Receiver
+    from virja.rmcp.transport import RmcpProtocol, open_listener
+    from virja.routing import Router
+    from virja.session import Performance
+
+    clock = SessionClock()
+    perf = Performance(router=Router(), planner=OnlinePlanner())
+    perf.keep_planned = False
+    sent_at: dict[int, float] = {}
+    lat: list[float] = []
+
+    def on_events(received: list[Any], now_s: float) -> None:
+        for rec in received:
+            perf.feed(rec.event, now_s=rec.arrival_s)
+        perf.advance(now_s)
+        done = time.perf_counter()
+        for rec in received:
+            ev = rec.event
+            if isinstance(ev, NoteOn):
+                key = round(ev.time_s * 1e6)
+                if key in sent_at:
+                    lat.append(done - sent_at.pop(key))
+
+    protocol = RmcpProtocol(Receiver(), clock, on_events)
+    transport = await open_listener("127.0.0.1", 0, protocol)
+    port = transport.get_extra_info("sockname")[1]
+    client = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    client.setblocking(False)
+    notes = [38, 42, 36, 51]
+    try:
+        for i in range(n):
+            t_us = clock.now_us() + 500_000  # a beat ahead at 120 bpm
+            data = bytes(wire.midi(2, i, t_us, bytes([0x99, notes[i % 4], 90])))
+            sent_at[t_us] = time.perf_counter()
+            client.sendto(data, ("127.0.0.1", port))
+            await asyncio.sleep(1 / rate_hz)
+        await asyncio.sleep(0.05)
+    finally:
+        client.close()
+        transport.close()
+    if not lat:
+        return (float("nan"), float("nan"))
+    arr = np.array(lat) * 1000
+    return float(np.percentile(arr, 50)), float(np.percentile(arr, 99))
+
+
+# -- planning -----------------------------------------------------------------
+
+
+def plan_beat_ms(beats: int = 300) -> tuple[float, float]:
+    """Planning one beat of 16 notes per performer known at once, p50 and p99 in ms."""
+    from virja.plan.bench import beat_workload, plan_one_beat
+    from virja.plan.config import default_config
+
+    config = default_config()
+    workloads = [beat_workload(seed, 16) for seed in range(beats)]
+    plan_one_beat(workloads[0], config)
+    times = []
+    for w in workloads:
+        start = time.perf_counter()
+        plan_one_beat(w, config)
+        times.append(time.perf_counter() - start)
+    arr = np.array(times) * 1000
+    return float(np.percentile(arr, 50)), float(np.percentile(arr, 99))
+
+
+def plan_streamed_ms(beats: int = 200) -> tuple[float, float]:
+    """The live case: each note of a beat (16 per performer) arrives in its own
+    datagram a beat ahead and the planner re-plans on each; per-beat p50, p99 ms."""
+    from virja.plan.planner import OnlinePlanner
+
+    rng = np.random.default_rng(7)
+    spb = 0.5
+    planner = OnlinePlanner()
+    drum_notes = [38, 42, 36, 51, 46, 45, 49]
+    times = []
+    for b in range(beats):
+        t_beat = b * spb
+        now = t_beat - spb
+        bass = [NoteOn(t_beat + k * spb / 16, 1, int(rng.integers(28, 60)), 90) for k in range(16)]
+        drums = [NoteOn(t_beat + k * spb / 16, 9, drum_notes[int(rng.integers(0, 7))], 90) for k in range(16)]
+        start = time.perf_counter()
+        for note in bass:
+            planner.add_note("bass", note, now_s=now)
+        for note in drums:
+            planner.add_note("drums", note, now_s=now)
+        planner.poll(now)
+        times.append(time.perf_counter() - start)
+    arr = np.array(times[10:]) * 1000
+    return float(np.percentile(arr, 50)), float(np.percentile(arr, 99))
+
+
+# -- motion and drawing -------------------------------------------------------
+
+
+def _demo_animator() -> tuple[Any, float, float]:
+    from virja.motion.band import BandAnimator
+    from virja.plan.planner import plan_notes
+    from virja.routing import Router, route_all
+
+    session = read_midi(demo_path())
+    routed = [
+        (p, e)
+        for p, e in route_all(session.events, Router.for_session(session))
+        if isinstance(e, NoteOn)
+    ]
+    animator = BandAnimator()
+    for b in session.beats:
+        animator.add_beat(b)
+    for p in plan_notes(routed, session.tempo_map):
+        animator.add_planned(p)
+    return animator, 0.0, session.duration_s
+
+
+def pose_ms(frames: int = 600) -> float:
+    """Sampling, blending and forward kinematics of both players, mean ms per frame."""
+    animator, t0, t1 = _demo_animator()
+    times = np.linspace(t0, t1, frames)
+    animator.pose(times[0])
+    start = time.perf_counter()
+    for t in times:
+        animator.pose(float(t))
+    return (time.perf_counter() - start) / frames * 1000
+
+
+def render_fps(
+    seconds: float = 3.0, readback: bool = False, size: tuple[int, int] = (1280, 720)
+) -> tuple[float, str]:
+    """Frames per second drawing the full band (pose included) headless; and the GL renderer."""
+    from virja.render.camera import PRESETS
+    from virja.render.hosts import OffscreenTarget, create_headless_context
+    from virja.render.renderer import Renderer
+    from virja.render.scene import band_scene, static_scene
+
+    animator, t0, t1 = _demo_animator()
+    ctx = create_headless_context()
+    renderer = Renderer(ctx)
+    target = OffscreenTarget(ctx, size, samples=4)
+    static = static_scene()
+    cam = PRESETS["front"]
+    gl_name = str(ctx.info.get("GL_RENDERER", "?"))
+    frames = 0
+    t = t0
+    start = time.perf_counter()
+    try:
+        while time.perf_counter() - start < seconds:
+            renderer.draw([static, band_scene(animator.pose(t))], cam, target.fbo)
+            if readback:
+                target.read_rgb()
+            else:
+                target.finish()
+            frames += 1
+            t = t0 + (t + 1 / 30 - t0) % max(t1 - t0, 1e-3)
+        elapsed = time.perf_counter() - start
+    finally:
+        target.release()
+        renderer.release()
+        ctx.release()
+    return frames / elapsed, gl_name
+
+
+def run_all(
+    quick: bool = False, progress: Callable[[str], None] | None = None
+) -> tuple[dict[str, Any], list[Figure]]:
+    say = progress or (lambda _msg: None)
+    scale = 0.4 if quick else 1.0
+    figs: list[Figure] = []
+    say("rmcp decode")
+    figs.append(
+        Figure(
+            "rmcp_datagrams_per_s",
+            rmcp_decode_rate(int(40_000 * scale)),
+            "datagrams/s",
+            20_000,
+            True,
+        )
+    )
+    say("rmcp latency")
+    p50, p99 = rmcp_latency_ms(int(1500 * scale))
+    figs.append(Figure("rmcp_latency_ms_p99", p99, "ms", 2.0, False, f"p50 {p50:.3f} ms"))
+    say("planning")
+    pp50, pp99 = plan_beat_ms(int(300 * scale))
+    s50, s99 = plan_streamed_ms(int(200 * scale))
+    note = f"p50 {pp50:.3f} ms; streamed note by note: p50 {s50:.2f} ms, p99 {s99:.2f} ms per beat"
+    figs.append(Figure("plan_ms_p99", pp99, "ms", 2.0, False, note))
+    say("pose")
+    figs.append(Figure("pose_ms", pose_ms(int(600 * scale)), "ms/frame", 1.0, False))
+    say("render")
+    fps, gl_name = render_fps(3.0 * scale)
+    figs.append(Figure("render_fps", fps, "frames/s", 60.0, True, "1280x720, 4x MSAA, no readback"))
+    say("render with readback")
+    fps_rb, _ = render_fps(3.0 * scale, readback=True)
+    figs.append(
+        Figure(
+            "render_fps_readback",
+            fps_rb,
+            "frames/s",
+            30.0,
+            True,
+            "1280x720, as for video at 30 fps",
+        )
+    )
+    info = machine() | {"gl_renderer": gl_name}
+    return info, figs

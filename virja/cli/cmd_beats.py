@@ -1,0 +1,38 @@
+"""Extract beat times from audio (method B: low-band power increments).
+
+Reads AUDIO (WAV, FLAC or anything libsndfile reads), mixes to mono,
+resamples to 8 kHz and prints one beat time in seconds per line; with
+--json one object {"beats": [...]}.  See docs/dance.md for the parameters.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from virja.dance.audio import read_audio_8k
+from virja.dance.beats import BeatParams, extract_beats
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("audio", metavar="AUDIO", help="audio file (WAV, FLAC, ...)")
+    parser.add_argument(
+        "--json", action="store_true", help='print {"beats": [...]} instead of lines'
+    )
+    parser.add_argument(
+        "--k",
+        type=float,
+        default=BeatParams().k_mad,
+        help="threshold: median + K robust deviations (default 4)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    x = read_audio_8k(args.audio)
+    beats = [round(float(b), 4) for b in extract_beats(x, BeatParams(k_mad=args.k))]
+    if args.json:
+        print(json.dumps({"beats": beats}))
+    else:
+        for b in beats:
+            print(f"{b:.4f}")
+    return 0

@@ -1,0 +1,156 @@
+"""Print the basic motion the scheduler picks for each note of a MIDI file or a recording.
+
+The notes go through the same planner as a live performance: each is revealed
+--lookahead-beats beats before it sounds (for a pcap recording of RMCP
+traffic: when its datagram was captured), and a motion, once started, is never
+changed.  Without --json: an aligned table and a summary (notes per performer,
+total cost, dropped and moved notes).  With --json: one JSON object per line
+per planned note, the keys of virja.plan.PlannedNote.
+
+Example:  virja plan song.mid --lookahead-beats 1
+          virja plan session.pcap --json > plan.jsonl
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+from virja.errors import ConfigError
+from virja.events import Beat, NoteOn
+from virja.plan.types import PlannedNote, PlanReport
+
+PCAP_SUFFIXES = {".pcap", ".pcapng", ".cap"}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("input", help="MIDI file (type 0/1) or pcap/pcapng recording of RMCP")
+    parser.add_argument("--json", action="store_true", help="one JSON object per planned note")
+    parser.add_argument(
+        "--lookahead-beats",
+        type=float,
+        default=1.0,
+        metavar="B",
+        help="MIDI files: each note is known B beats before it sounds (default 1)",
+    )
+    parser.add_argument("--config", default=None, metavar="FILE.toml", help="[plan] and [routing]")
+    parser.add_argument(
+        "--port", type=int, default=None, metavar="N", help="pcap: the RMCP UDP port"
+    )
+
+
+def _plan_midi(
+    path: Path, args: argparse.Namespace, doc: dict[str, Any]
+) -> tuple[list[PlannedNote], PlanReport]:
+    from virja.config import section
+    from virja.midifile import read_midi
+    from virja.plan import load_plan_config, plan_notes_with_report
+    from virja.routing import Router, RoutingConfig, route_all
+
+    session = read_midi(path)
+    router = Router.for_session(session, RoutingConfig.from_dict(section(doc, "routing")))
+    notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
+    return plan_notes_with_report(
+        notes,
+        session.tempo_map,
+        lookahead_beats=args.lookahead_beats,
+        config=load_plan_config(args.config),
+    )
+
+
+def _plan_pcap(
+    path: Path, args: argparse.Namespace, doc: dict[str, Any]
+) -> tuple[list[PlannedNote], PlanReport]:
+    from virja.config import section
+    from virja.plan import OnlinePlanner, load_plan_config
+    from virja.rmcp.pcap import read_capture
+    from virja.rmcp.receiver import Receiver
+    from virja.routing import Router, RoutingConfig
+
+    capture = read_capture(path) if args.port is None else read_capture(path, port=args.port)
+    receiver = Receiver()
+    router = Router(RoutingConfig.from_dict(section(doc, "routing")))
+    planner = OnlinePlanner(load_plan_config(args.config))
+    out: list[PlannedNote] = []
+    for dgram in capture.datagrams:
+        receiver.receive_datagram(dgram.payload, dgram.src, now_us=dgram.time_us)
+        for rec in receiver.drain_events():
+            out.extend(planner.poll(rec.arrival_s))
+            ev = rec.event
+            if isinstance(ev, Beat):
+                planner.add_beat(ev)
+                continue
+            who = router.route(ev)
+            if who is not None and isinstance(ev, NoteOn):
+                planner.add_note(who, ev, now_s=rec.arrival_s)
+    out.extend(planner.flush())
+    return out, planner.report
+
+
+def _fmt(value: object) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.3f}"
+    return str(value)
+
+
+def _table(planned: list[PlannedNote]) -> list[str]:
+    cols = ["time", "performer", "note", "limb", "motion", "start", "impact", "cost", "late"]
+    rows = [[_fmt(getattr(p, c)) if c != "late" else ("LATE" if p.late else "") for c in cols]
+            for p in sorted(planned, key=lambda p: (p.time, p.performer, p.start))]  # fmt: skip
+    widths = [max([len(c)] + [len(r[i]) for r in rows]) for i, c in enumerate(cols)]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(cols, widths, strict=True)).rstrip()]
+    lines += ["  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip() for r in rows]
+    return lines
+
+
+def _summary(planned: list[PlannedNote], report: PlanReport) -> list[str]:
+    per = Counter(p.performer for p in planned)
+    cost: dict[str, float] = {"bass": 0.0, "drums": 0.0}
+    for p in planned:
+        cost[p.performer] += p.cost
+    lines = [
+        f"{who}: {per[who]} notes planned, total cost {cost[who]:g}, "
+        f"{sum(1 for p in planned if p.performer == who and p.late)} late"
+        for who in ("bass", "drums")
+    ]
+    drops = Counter((d.performer, d.reason) for d in report.dropped)
+    lines.append(
+        f"dropped: {len(report.dropped)}"
+        + "".join(f"; {who} {reason}: {n}" for (who, reason), n in sorted(drops.items()))
+    )
+    lines.append(
+        f"moved by octaves: {len(report.moved)}"
+        + "".join(f"; {m.note.note} -> {m.played_note} at {m.note.time_s:.3f} s"
+                  for m in report.moved[:10])
+        + (" ..." if len(report.moved) > 10 else "")
+    )  # fmt: skip
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    from virja.config import load_config
+
+    if args.lookahead_beats < 0:
+        raise ConfigError("--lookahead-beats must be >= 0")
+    path = Path(args.input)
+    doc = load_config(args.config)
+    is_pcap = path.suffix.lower() in PCAP_SUFFIXES
+    planned, report = (_plan_pcap if is_pcap else _plan_midi)(path, args, doc)
+    if args.json:
+        try:
+            for p in planned:
+                print(json.dumps(p.to_json()))
+        except BrokenPipeError:  # `virja plan --json ... | head`
+            return 0
+        return 0
+    for line in _table(planned):
+        print(line)
+    print()
+    for line in _summary(planned, report):
+        print(line)
+    return 0

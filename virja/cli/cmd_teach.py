@@ -1,0 +1,56 @@
+"""Build a motion database from a capture and its music (method B).
+
+CAPTURE.bvh is cut into motion segments where the angular acceleration of
+the chosen parts (--parts legs|arms|all) has a minimum on a beat of
+MUSIC (any audio libsndfile reads; beats extracted as by `virja beats`);
+each segment is stored with the AR(3) sound parameters of its music
+phrase.  The capture and the music must start together.  The database is a
+folder (manifest.json + segments.npz, docs/dance.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from virja.dance.audio import read_audio_8k
+from virja.dance.database import DanceError, load_database, merge, save_database, teach
+from virja.dance.segment import DEFAULT_TOLERANCE_FRAMES, PARTS
+from virja.motion.bvh import read_bvh
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("capture", metavar="CAPTURE.bvh", help="motion capture (BVH)")
+    parser.add_argument("music", metavar="MUSIC", help="the music the capture was danced to")
+    parser.add_argument(
+        "--parts", choices=PARTS, default="legs", help="parts that decide the cuts (default legs)"
+    )
+    parser.add_argument("--out", required=True, metavar="DB", help="database folder to write")
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        default=DEFAULT_TOLERANCE_FRAMES,
+        metavar="FRAMES",
+        help="how far a beat may be from a minimum of acceleration (default 3 frames)",
+    )
+    parser.add_argument("--append", action="store_true", help="add to the segments already in DB")
+
+
+def run(args: argparse.Namespace) -> int:
+    bvh = read_bvh(args.capture)
+    audio = read_audio_8k(args.music)
+    db = teach(
+        bvh, audio, args.parts, tolerance_frames=args.tolerance, source=Path(args.capture).name
+    )
+    if not db.segments:
+        raise DanceError(
+            f"{args.capture}: no motion segments found (no acceleration minimum meets a beat)"
+        )
+    if args.append and (Path(args.out) / "manifest.json").exists():
+        db = merge([load_database(args.out), db])
+    save_database(db, args.out)
+    spans = db.spans
+    print(
+        f"{args.out}: {len(spans)} segments of {min(spans)}-{max(spans)} frames ({args.parts}, {db.fps:g} fps)"
+    )
+    return 0

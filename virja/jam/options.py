@@ -1,0 +1,77 @@
+"""The options of a jam: the ``[jam]`` table of the config file, overridden by flags.
+
+```toml
+[jam]
+api = "jack"          # "jack" | "alsa"; absent: the first that works here
+port = "Keystation"   # connect to the first source whose name contains this
+split = 48            # lowest key of the pianist's part (C3); below it: the bassist
+upper = "ignore"      # "ignore" | "drums": the upper keys play the drummer
+delay_ms = 0          # put sound (thru) and picture off by this much
+thru = "fluidsynth"   # forward notes to the first synth port whose name contains this
+send = "host:50500"   # also stream the band's notes as RMCP/1 to a `virja serve`
+fps = 60              # frames per second of the loop (headless: the planner's tick)
+```
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from virja.errors import ConfigError
+from virja.jam.keyboard import DEFAULT_SPLIT, UPPER_MODES, KeyboardLayout, UpperMode
+from virja.jam.ports import API_NAMES
+
+MAX_DELAY_MS = 2000.0  # more than two seconds is not a jam any more; a typo, most likely
+
+_KEYS = ("api", "port", "split", "upper", "delay_ms", "thru", "send", "fps")
+
+
+@dataclass(frozen=True, slots=True)
+class JamOptions:
+    api: str | None = None
+    port: str | None = None
+    split: int = DEFAULT_SPLIT
+    upper: UpperMode = "ignore"
+    delay_ms: float = 0.0
+    thru: str | None = None
+    send: str | None = None
+    fps: float = 60.0
+
+    def __post_init__(self) -> None:
+        if self.api is not None and self.api not in API_NAMES:
+            raise ConfigError(f"api must be one of {', '.join(API_NAMES)}, got {self.api!r}")
+        if not 0.0 <= self.delay_ms <= MAX_DELAY_MS:
+            raise ConfigError(f"delay_ms must be 0-{MAX_DELAY_MS:g}, got {self.delay_ms:g}")
+        if not 1.0 <= self.fps <= 1000.0:
+            raise ConfigError(f"fps must be 1-1000, got {self.fps:g}")
+        if self.upper not in UPPER_MODES:
+            raise ConfigError(f"upper must be one of {', '.join(UPPER_MODES)}, got {self.upper!r}")
+        self.layout  # noqa: B018 - validates the split
+
+    @property
+    def layout(self) -> KeyboardLayout:
+        return KeyboardLayout(split=self.split, upper=self.upper)
+
+    @property
+    def delay_s(self) -> float:
+        return self.delay_ms / 1000.0
+
+    @classmethod
+    def merge(cls, table: Mapping[str, Any], overrides: Mapping[str, Any]) -> JamOptions:
+        """The ``[jam]`` table with the flags given (None: not given) on top."""
+        unknown = sorted(set(table) - set(_KEYS))
+        if unknown:
+            raise ConfigError(f"[jam]: unknown key(s) {', '.join(unknown)}; known: {_KEYS}")
+        values: dict[str, Any] = dict(table)
+        values.update({k: v for k, v in overrides.items() if k in _KEYS and v is not None})
+        for key, typ in (("split", int), ("delay_ms", (int, float)), ("fps", (int, float))):
+            if key in values and (
+                not isinstance(values[key], typ) or isinstance(values[key], bool)
+            ):
+                raise ConfigError(f"[jam] {key} must be a number, got {values[key]!r}")
+        for key in ("api", "port", "upper", "thru", "send"):
+            if key in values and not isinstance(values[key], str):
+                raise ConfigError(f"[jam] {key} must be a string, got {values[key]!r}")
+        return cls(**values)

@@ -1,0 +1,134 @@
+"""What the scheduler hands on: one :class:`PlannedNote` per played note, and a report.
+
+``PlannedNote`` is the contract between the planner and the animator (and the
+``virja plan --json`` / plan-log format): its fields, in order, are exactly the
+JSON keys.  All times are session seconds (``float``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from virja.events import NoteOn, Performer
+
+Limb = Literal["left_hand", "right_hand", "left_foot", "right_foot"]
+LIMBS: tuple[Limb, ...] = ("left_hand", "right_hand", "left_foot", "right_foot")
+
+JSON_KEYS: tuple[str, ...] = (
+    "time",
+    "performer",
+    "channel",
+    "note",
+    "velocity",
+    "limb",
+    "piece",
+    "string",
+    "fret",
+    "motion",
+    "start",
+    "impact",
+    "cost",
+    "late",
+)
+
+
+@dataclass(frozen=True)
+class PlannedNote:
+    """One note with the basic motion chosen to play it.
+
+    ``time`` when it sounds; ``start`` when its motion starts; ``impact`` when
+    stick or finger meets the instrument (== ``time`` unless ``late``).
+    Drums: ``piece`` set, ``string``/``fret`` None.  Bass: ``string`` and
+    ``fret`` set (``fret`` 0 = open string), ``piece`` None, ``limb`` is the
+    plucking hand ``"right_hand"``; ``note`` is the pitch actually played
+    (after any octave move, see :class:`MovedNote`).  ``cost`` is the
+    transition cost this motion paid (docs/scheduler.md).
+    """
+
+    time: float
+    performer: Performer
+    channel: int
+    note: int
+    velocity: int
+    limb: Limb
+    piece: str | None
+    string: str | None
+    fret: int | None
+    motion: str
+    start: float
+    impact: float
+    cost: float
+    late: bool
+
+    def to_json(self) -> dict[str, Any]:
+        """A dict with exactly :data:`JSON_KEYS`, in that order."""
+        return {key: getattr(self, key) for key in JSON_KEYS}
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> PlannedNote:
+        """Inverse of :meth:`to_json`; raises ``ValueError`` on missing or extra keys."""
+        keys = set(data)
+        if keys != set(JSON_KEYS):
+            missing = sorted(set(JSON_KEYS) - keys)
+            extra = sorted(keys - set(JSON_KEYS))
+            raise ValueError(f"planned note keys wrong: missing {missing}, unexpected {extra}")
+        return cls(
+            time=float(data["time"]),
+            performer=data["performer"],
+            channel=int(data["channel"]),
+            note=int(data["note"]),
+            velocity=int(data["velocity"]),
+            limb=data["limb"],
+            piece=data["piece"],
+            string=data["string"],
+            fret=None if data["fret"] is None else int(data["fret"]),
+            motion=str(data["motion"]),
+            start=float(data["start"]),
+            impact=float(data["impact"]),
+            cost=float(data["cost"]),
+            late=bool(data["late"]),
+        )
+
+
+DropReason = Literal[
+    "too_many_hands",  # more simultaneous hand pieces than hands (priority kept the others)
+    "too_fast",  # the limb cannot strike again so soon (minimum inter-stroke time)
+    "too_late",  # arrived after later notes of its limb had been fixed, and no limb was free
+    "unmapped",  # a drum note outside the kit map
+    "no_double_stop",  # a simultaneous bass note that cannot be stopped with the melody note
+]
+
+
+@dataclass(frozen=True)
+class DroppedNote:
+    """A note the planner did not play, and why."""
+
+    performer: Performer
+    note: NoteOn
+    reason: DropReason
+
+
+@dataclass(frozen=True)
+class MovedNote:
+    """A bass note outside the instrument's range, moved by octaves into it."""
+
+    performer: Performer
+    note: NoteOn
+    played_note: int
+
+
+@dataclass(frozen=True)
+class PlanReport:
+    """Everything the planner did not play as written."""
+
+    dropped: tuple[DroppedNote, ...] = field(default_factory=tuple)
+    moved: tuple[MovedNote, ...] = field(default_factory=tuple)
+
+    def summary(self) -> dict[str, int]:
+        """Counts by kind: ``{"dropped": n, "moved": m, "dropped_<reason>": k, ...}``."""
+        out = {"dropped": len(self.dropped), "moved": len(self.moved)}
+        for d in self.dropped:
+            key = f"dropped_{d.reason}"
+            out[key] = out.get(key, 0) + 1
+        return out

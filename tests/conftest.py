@@ -23,7 +23,9 @@ def gl_ctx() -> Iterator[object]:
     ctx.release()
 
 
-def save_midi(path: Path, tracks: list[list[mido.Message | mido.MetaMessage]], tpb: int = 480, type_: int = 1) -> Path:
+def save_midi(
+    path: Path, tracks: list[list[mido.Message | mido.MetaMessage]], tpb: int = 480, type_: int = 1
+) -> Path:
     mf = mido.MidiFile(type=type_, ticks_per_beat=tpb)
     for msgs in tracks:
         mf.tracks.append(mido.MidiTrack(msgs))

@@ -12,7 +12,7 @@ from virja.errors import ConfigError, InputFileError
 
 def test_valid_config_loads(tmp_path: Path) -> None:
     p = tmp_path / "v.toml"
-    p.write_text('[routing]\ndrum_channels = [10, 11]\n')
+    p.write_text("[routing]\ndrum_channels = [10, 11]\n")
     assert load_config(p) == {"routing": {"drum_channels": [10, 11]}}
 
 

@@ -35,15 +35,33 @@ def test_tempo_change_mid_file_moves_later_notes(tmp_path: Path) -> None:
 
 
 def test_note_on_with_velocity_zero_is_a_note_off(tmp_path: Path) -> None:
-    s = read_midi(save_midi(tmp_path / "t.mid", [[M("note_on", note=60, velocity=80, time=0), M("note_on", note=60, velocity=0, time=240)]]))
+    s = read_midi(
+        save_midi(
+            tmp_path / "t.mid",
+            [
+                [
+                    M("note_on", note=60, velocity=80, time=0),
+                    M("note_on", note=60, velocity=0, time=240),
+                ]
+            ],
+        )
+    )
     assert [type(e) for e in s.events] == [NoteOn, NoteOff]
     assert s.events[1].time_s == pytest.approx(0.25)
 
 
 def test_running_status_is_decoded(tmp_path: Path) -> None:
     """A raw file whose second note_on omits its status byte."""
-    track = bytes([0x00, 0x90, 60, 100, 0x60, 62, 100, 0x60, 60, 0, 0x00, 62, 0, 0x00, 0xFF, 0x2F, 0x00])
-    data = b"MThd" + (6).to_bytes(4, "big") + (0).to_bytes(2, "big") + (1).to_bytes(2, "big") + (96).to_bytes(2, "big")
+    track = bytes(
+        [0x00, 0x90, 60, 100, 0x60, 62, 100, 0x60, 60, 0, 0x00, 62, 0, 0x00, 0xFF, 0x2F, 0x00]
+    )
+    data = (
+        b"MThd"
+        + (6).to_bytes(4, "big")
+        + (0).to_bytes(2, "big")
+        + (1).to_bytes(2, "big")
+        + (96).to_bytes(2, "big")
+    )
     data += b"MTrk" + len(track).to_bytes(4, "big") + track
     p = tmp_path / "rs.mid"
     p.write_bytes(data)
@@ -58,7 +76,10 @@ def test_running_status_is_decoded(tmp_path: Path) -> None:
 
 def test_several_tracks_share_the_conductor_tempo(tmp_path: Path) -> None:
     conductor = [Meta("set_tempo", tempo=250_000, time=0)]
-    a = [Meta("track_name", name="Bass", time=0), M("note_on", channel=1, note=40, velocity=90, time=480)]
+    a = [
+        Meta("track_name", name="Bass", time=0),
+        M("note_on", channel=1, note=40, velocity=90, time=480),
+    ]
     b = [M("note_on", channel=9, note=38, velocity=90, time=960)]
     s = read_midi(save_midi(tmp_path / "t.mid", [conductor, a, b]))
     ons = [e for e in s.events if isinstance(e, NoteOn)]
@@ -80,15 +101,25 @@ def test_overlapping_notes_keep_both_onsets_and_offsets(tmp_path: Path) -> None:
 
 
 def test_program_changes_become_events(tmp_path: Path) -> None:
-    s = read_midi(save_midi(tmp_path / "t.mid", [[M("program_change", channel=2, program=33, time=0)]]))
+    s = read_midi(
+        save_midi(tmp_path / "t.mid", [[M("program_change", channel=2, program=33, time=0)]])
+    )
     assert s.events == [ProgramChange(0.0, 2, 33, track=0)]
     assert s.tracks[0].programs == frozenset({33})
 
 
 def test_beats_follow_the_time_signature(tmp_path: Path) -> None:
-    conductor = [Meta("time_signature", numerator=3, denominator=4, time=0), Meta("end_of_track", time=480 * 6)]
+    conductor = [
+        Meta("time_signature", numerator=3, denominator=4, time=0),
+        Meta("end_of_track", time=480 * 6),
+    ]
     s = read_midi(save_midi(tmp_path / "t.mid", [conductor]))
-    assert [(b.bar, b.beat, b.level) for b in s.beats[:4]] == [(0, 1, 2), (0, 2, 0), (0, 3, 0), (1, 1, 2)]
+    assert [(b.bar, b.beat, b.level) for b in s.beats[:4]] == [
+        (0, 1, 2),
+        (0, 2, 0),
+        (0, 3, 0),
+        (1, 1, 2),
+    ]
 
 
 @pytest.mark.parametrize(
@@ -96,10 +127,15 @@ def test_beats_follow_the_time_signature(tmp_path: Path) -> None:
     [
         (b"", "not a readable MIDI file"),
         (b"RIFF0000WAVEfmt ", "not a readable MIDI file"),
-        (b"MThd\x00\x00\x00\x06\x00\x01\x00\x01\x01\xe0MTrk\x00\x00\x00\x10\x00\x90", "not a readable MIDI file"),
+        (
+            b"MThd\x00\x00\x00\x06\x00\x01\x00\x01\x01\xe0MTrk\x00\x00\x00\x10\x00\x90",
+            "not a readable MIDI file",
+        ),
     ],
 )
-def test_malformed_file_gives_clear_error_naming_the_file(tmp_path: Path, content: bytes, reason: str) -> None:
+def test_malformed_file_gives_clear_error_naming_the_file(
+    tmp_path: Path, content: bytes, reason: str
+) -> None:
     p = tmp_path / "bad.mid"
     p.write_bytes(content)
     with pytest.raises(InputFileError, match=reason) as info:

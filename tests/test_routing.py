@@ -36,7 +36,17 @@ def test_unprogrammed_unnamed_part_is_not_the_bands() -> None:
     assert Router().route(NoteOn(0.0, 0, 60, 90)) is None
 
 
-@pytest.mark.parametrize("name, expected", [("Bass", True), ("Acoustic Bass 1", True), ("Kontrabass", True), ("Bass Drum", False), ("Bassoon", False), ("Piano", False)])
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        ("Bass", True),
+        ("Acoustic Bass 1", True),
+        ("Kontrabass", True),
+        ("Bass Drum", False),
+        ("Bassoon", False),
+        ("Piano", False),
+    ],
+)
 def test_bass_track_names(name: str, expected: bool) -> None:
     assert looks_like_bass(name) is expected
 
@@ -53,7 +63,14 @@ def test_cli_flags_win_over_the_file() -> None:
     assert Router(cfg).route(NoteOn(0, 1, 40, 90)) == "bass"
 
 
-@pytest.mark.parametrize("table, text", [({"channels": {"17": "bass"}}, "1-16"), ({"channels": {"2": "piano"}}, "must be one of"), ({"colour": 1}, "unknown key")])
+@pytest.mark.parametrize(
+    "table, text",
+    [
+        ({"channels": {"17": "bass"}}, "1-16"),
+        ({"channels": {"2": "piano"}}, "must be one of"),
+        ({"colour": 1}, "unknown key"),
+    ],
+)
 def test_bad_routing_config_is_a_clear_error(table: dict[str, object], text: str) -> None:
     with pytest.raises(ConfigError, match=text):
         RoutingConfig.from_dict(table)

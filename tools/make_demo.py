@@ -23,7 +23,13 @@ BARS = 12
 # F blues: F7 Bb7 F7 F7 | Bb7 Bb7 F7 D7 | Gm7 C7 F7 C7
 CHORDS = ["F7", "Bb7", "F7", "F7", "Bb7", "Bb7", "F7", "D7", "Gm7", "C7", "F7", "C7"]
 ROOTS = {"F7": 41, "Bb7": 34, "D7": 38, "Gm7": 43, "C7": 36}  # bass register MIDI notes
-CHORD_TONES = {"F7": [0, 4, 7, 10], "Bb7": [0, 4, 7, 10], "D7": [0, 4, 7, 10], "Gm7": [0, 3, 7, 10], "C7": [0, 4, 7, 10]}
+CHORD_TONES = {
+    "F7": [0, 4, 7, 10],
+    "Bb7": [0, 4, 7, 10],
+    "D7": [0, 4, 7, 10],
+    "Gm7": [0, 3, 7, 10],
+    "C7": [0, 4, 7, 10],
+}
 
 
 def walking_line() -> list[int]:
@@ -55,7 +61,9 @@ def events_to_track(name: str, events: list[tuple[int, mido.Message]]) -> mido.M
     return track
 
 
-def note(events: list[tuple[int, mido.Message]], ch: int, n: int, start: int, dur: int, vel: int) -> None:
+def note(
+    events: list[tuple[int, mido.Message]], ch: int, n: int, start: int, dur: int, vel: int
+) -> None:
     events.append((start, mido.Message("note_on", channel=ch, note=n, velocity=vel)))
     events.append((start + dur, mido.Message("note_off", channel=ch, note=n, velocity=0)))
 
@@ -69,7 +77,9 @@ def build() -> mido.MidiFile:
     conductor.append(mido.MetaMessage("end_of_track", time=BARS * 4 * TPB))
     mf.tracks.append(conductor)
 
-    bass: list[tuple[int, mido.Message]] = [(0, mido.Message("program_change", channel=1, program=32))]
+    bass: list[tuple[int, mido.Message]] = [
+        (0, mido.Message("program_change", channel=1, program=32))
+    ]
     for i, n in enumerate(walking_line()):
         note(bass, 1, n, i * TPB, TPB - 40, 96 if i % 4 == 0 else 84)
     mf.tracks.append(events_to_track("Walking Bass", bass))
@@ -100,12 +110,21 @@ def build() -> mido.MidiFile:
     note(drums, 9, 36, BARS * 4 * TPB, 200, 110)
     mf.tracks.append(events_to_track("Drums", drums))
 
-    piano: list[tuple[int, mido.Message]] = [(0, mido.Message("program_change", channel=0, program=0))]
+    piano: list[tuple[int, mido.Message]] = [
+        (0, mido.Message("program_change", channel=0, program=0))
+    ]
     for bar, ch in enumerate(CHORDS):
         root = ROOTS[ch] + 12
         for beat in (0, 2):
             for tone in CHORD_TONES[ch][1:]:
-                note(piano, 0, root + tone + 12, bar * 4 * TPB + beat * TPB + swing * (beat // 2), 300, 70)
+                note(
+                    piano,
+                    0,
+                    root + tone + 12,
+                    bar * 4 * TPB + beat * TPB + swing * (beat // 2),
+                    300,
+                    70,
+                )
     note(bass, 1, 41, BARS * 4 * TPB, TPB * 2, 100)
     mf.tracks[1] = events_to_track("Walking Bass", bass)
     mf.tracks.append(events_to_track("Piano", piano))
@@ -113,7 +132,11 @@ def build() -> mido.MidiFile:
 
 
 def main() -> int:
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parent.parent / "virja/demo/blues.mid"
+    out = (
+        Path(sys.argv[1])
+        if len(sys.argv) > 1
+        else Path(__file__).resolve().parent.parent / "virja/demo/blues.mid"
+    )
     out.parent.mkdir(parents=True, exist_ok=True)
     build().save(str(out))
     print(f"wrote {out}")

@@ -190,7 +190,10 @@ def plan_streamed_ms(beats: int = 200) -> tuple[float, float]:
         t_beat = b * spb
         now = t_beat - spb
         bass = [NoteOn(t_beat + k * spb / 16, 1, int(rng.integers(28, 60)), 90) for k in range(16)]
-        drums = [NoteOn(t_beat + k * spb / 16, 9, drum_notes[int(rng.integers(0, 7))], 90) for k in range(16)]
+        drums = [
+            NoteOn(t_beat + k * spb / 16, 9, drum_notes[int(rng.integers(0, 7))], 90)
+            for k in range(16)
+        ]
         start = time.perf_counter()
         for note in bass:
             planner.add_note("bass", note, now_s=now)
@@ -236,7 +239,10 @@ def pose_ms(frames: int = 600) -> float:
 
 
 def render_fps(
-    seconds: float = 3.0, readback: bool = False, size: tuple[int, int] = (1280, 720)
+    seconds: float = 3.0,
+    readback: bool = False,
+    size: tuple[int, int] = (1280, 720),
+    samples: int = 1,
 ) -> tuple[float, str]:
     """Frames per second drawing the full band (pose included) headless; and the GL renderer."""
     from virja.render.camera import PRESETS
@@ -247,7 +253,7 @@ def render_fps(
     animator, t0, t1 = _demo_animator()
     ctx = create_headless_context()
     renderer = Renderer(ctx)
-    target = OffscreenTarget(ctx, size, samples=4)
+    target = OffscreenTarget(ctx, size, samples=samples)
     static = static_scene()
     cam = PRESETS["front"]
     gl_name = str(ctx.info.get("GL_RENDERER", "?"))

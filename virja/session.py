@@ -167,3 +167,18 @@ class RevealFeeder:
     @property
     def done(self) -> bool:
         return self.next >= len(self.schedule)
+
+
+def run_schedule(perf: Performance, schedule: list[Reveal]) -> list[PlannedNote]:
+    """Play a whole reveal schedule on a virtual clock as fast as possible.
+
+    The clock jumps from reveal to reveal; at each, what started is committed
+    and the event is fed, exactly as the live daemon does when a datagram
+    arrives.  Returns every planned note, in commit order.
+    """
+    out: list[PlannedNote] = []
+    for r in schedule:
+        out.extend(perf.advance(r.at_s))
+        perf.feed(r.event, now_s=r.at_s)
+    out.extend(perf.finish())
+    return out

@@ -25,15 +25,34 @@ VIRJA = [sys.executable, "-m", "virja"]
 def short_session(path: Path) -> Path:
     """Two beats at 120 bpm: bass eighths, snare + hi-hat with a snare sixteenth between, a piano."""
     conductor = [Meta("set_tempo", tempo=500_000, time=0)]
-    bass = [Meta("track_name", name="Bass", time=0), M("program_change", channel=1, program=32, time=0)]
+    bass = [
+        Meta("track_name", name="Bass", time=0),
+        M("program_change", channel=1, program=32, time=0),
+    ]
     for i, n in enumerate([41, 46, 48, 41]):
-        bass += [M("note_on", channel=1, note=n, velocity=90, time=0 if i == 0 else 0), M("note_off", channel=1, note=n, time=240)]
+        bass += [
+            M("note_on", channel=1, note=n, velocity=90, time=0 if i == 0 else 0),
+            M("note_off", channel=1, note=n, time=240),
+        ]
     drums = []
     for _ in range(4):
-        drums += [M("note_on", channel=9, note=38, velocity=100, time=0), M("note_on", channel=9, note=42, velocity=80, time=0)]
-        drums += [M("note_off", channel=9, note=38, time=120), M("note_off", channel=9, note=42, time=0)]
-        drums += [M("note_on", channel=9, note=38, velocity=70, time=0), M("note_off", channel=9, note=38, time=120)]
-    piano = [M("program_change", channel=0, program=0, time=0), M("note_on", channel=0, note=72, velocity=60, time=0), M("note_off", channel=0, note=72, time=480)]
+        drums += [
+            M("note_on", channel=9, note=38, velocity=100, time=0),
+            M("note_on", channel=9, note=42, velocity=80, time=0),
+        ]
+        drums += [
+            M("note_off", channel=9, note=38, time=120),
+            M("note_off", channel=9, note=42, time=0),
+        ]
+        drums += [
+            M("note_on", channel=9, note=38, velocity=70, time=0),
+            M("note_off", channel=9, note=38, time=120),
+        ]
+    piano = [
+        M("program_change", channel=0, program=0, time=0),
+        M("note_on", channel=0, note=72, velocity=60, time=0),
+        M("note_off", channel=0, note=72, time=480),
+    ]
     return save_midi(path, [conductor, bass, drums, piano])
 
 
@@ -43,7 +62,20 @@ def test_send_serve_record_replay_give_one_plan(tmp_path: Path) -> None:
     pcap = tmp_path / "live.pcap"
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     serve = subprocess.Popen(
-        [*VIRJA, "serve", "--headless", "--quiet", "--listen", "127.0.0.1:0", "--plan-log", str(plan_live), "--record", str(pcap), "--duration", "6"],
+        [
+            *VIRJA,
+            "serve",
+            "--headless",
+            "--quiet",
+            "--listen",
+            "127.0.0.1:0",
+            "--plan-log",
+            str(plan_live),
+            "--record",
+            str(pcap),
+            "--duration",
+            "6",
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -82,7 +114,16 @@ def test_send_serve_record_replay_give_one_plan(tmp_path: Path) -> None:
 
     plan_replay = tmp_path / "replay.jsonl"
     rep = subprocess.run(
-        [*VIRJA, "replay", str(pcap), "--port", str(port), "--headless", "--plan-log", str(plan_replay)],
+        [
+            *VIRJA,
+            "replay",
+            str(pcap),
+            "--port",
+            str(port),
+            "--headless",
+            "--plan-log",
+            str(plan_replay),
+        ],
         capture_output=True,
         text=True,
         timeout=60,
@@ -100,13 +141,22 @@ def test_replay_of_a_capture_without_rmcp_is_a_clear_error(tmp_path: Path) -> No
     p = tmp_path / "other.pcap"
     with PcapWriter.open(p, local=("127.0.0.1", 9999)) as w:
         w.write(b"hello", ("127.0.0.1", 1234), time_us=1)
-    res = subprocess.run([*VIRJA, "replay", str(p), "--headless"], capture_output=True, text=True, timeout=60)
+    res = subprocess.run(
+        [*VIRJA, "replay", str(p), "--headless"], capture_output=True, text=True, timeout=60
+    )
     assert res.returncode == 1
     assert "no UDP datagrams to port 50500" in res.stderr
     assert "Traceback" not in res.stderr
 
 
-@pytest.mark.parametrize("cmd", [["render", "nope.mid", "--out", "x.mp4"], ["plan", "nope.mid"], ["replay", "nope.pcap", "--headless"]])
+@pytest.mark.parametrize(
+    "cmd",
+    [
+        ["render", "nope.mid", "--out", "x.mp4"],
+        ["plan", "nope.mid"],
+        ["replay", "nope.pcap", "--headless"],
+    ],
+)
 def test_missing_input_is_a_one_line_error(tmp_path: Path, cmd: list[str]) -> None:
     res = subprocess.run([*VIRJA, *cmd], capture_output=True, text=True, timeout=60, cwd=tmp_path)
     assert res.returncode != 0

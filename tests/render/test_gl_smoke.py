@@ -25,7 +25,9 @@ def test_sphere_is_drawn_where_the_camera_projects_it(gl_ctx: Any) -> None:
     r.draw(dl, cam, target.fbo)
     img = target.read_rgb()
     assert gl_ctx.error == "GL_NO_ERROR"
-    (x, y), = project(cam.view_proj(96 / 64), np.array([[0.4, 1.2, 0.0]]), (96, 64)).round().astype(int)
+    ((x, y),) = (
+        project(cam.view_proj(96 / 64), np.array([[0.4, 1.2, 0.0]]), (96, 64)).round().astype(int)
+    )
     red = img[y, x]
     assert red[0] > 120 and int(red[0]) > int(red[1]) + 30, red
     bg = np.round(np.array(BACKGROUND) * 255)  # the clear colour is written as is

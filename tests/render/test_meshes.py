@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from virja.errors import ConfigError
 from virja.render.camera import Camera, project
 from virja.render.meshes import MESHES, pack_instances, segment_transforms, sphere_transforms
 from virja.render.offline import OutputSpec, parse_size
-from virja.errors import ConfigError
 
 
 @pytest.mark.parametrize("kind", sorted(MESHES))
@@ -41,7 +41,7 @@ def test_pack_instances_is_column_major() -> None:
 
 def test_camera_projects_its_target_to_the_centre() -> None:
     cam = Camera(target=(0.3, 1.0, -0.2), yaw_deg=30, pitch_deg=20)
-    (x, y), = project(cam.view_proj(16 / 9), np.array([cam.target]), (1600, 900))
+    ((x, y),) = project(cam.view_proj(16 / 9), np.array([cam.target]), (1600, 900))
     assert x == pytest.approx(800) and y == pytest.approx(450)
 
 

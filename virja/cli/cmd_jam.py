@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 from virja.config import section
-from virja.errors import ConfigError, InputFileError, NotAvailableError
+from virja.errors import ConfigError, InputFileError
 
 if TYPE_CHECKING:
     from virja.jam.live import KeyboardJam
@@ -129,24 +129,58 @@ def _plan_log(path: str | None) -> Iterator[IO[str] | None]:
         yield fh
 
 
+IMMEDIATE_STROKE_S = 0.012  # default jam mode: a key's stroke lands within a frame
+
+
+def jam_plan_config(config_path: str | None, delay_s: float) -> Any:
+    """The scheduler's tables for a jam.
+
+    Without --delay-ms a key's note is already due when it arrives, so every
+    motion is compressed; its shortest stroke is cut to IMMEDIATE_STROKE_S so the
+    impact is drawn within a frame of the key.  With a delay at least as long as
+    the longest anticipation the tables are used as they are.
+    """
+    import dataclasses
+
+    from virja.plan.config import load_plan_config
+
+    config = load_plan_config(config_path)
+    if delay_s > 0:
+        return config
+    kinds = {
+        k: dataclasses.replace(
+            mt, min_anticipation_s=min(mt.min_anticipation_s, IMMEDIATE_STROKE_S)
+        )
+        for k, mt in config.timing.kinds.items()
+    }
+    return dataclasses.replace(config, timing=dataclasses.replace(config.timing, kinds=kinds))
+
+
 def build_performance(
-    doc: dict[str, Any], *, plan_log: IO[str] | None, animate: bool
+    doc: dict[str, Any],
+    *,
+    plan_log: IO[str] | None,
+    animate: bool,
+    delay_s: float = 0.0,
+    config_path: str | None = None,
 ) -> Performance:
     """The one place where the jam meets the band: router + planner (+ animator).
 
     Events reach the performance already routed by the keyboard split
     (``feed_routed``); its router is there for the Performance's contract only.
-    Drawing (``animate``) is not wired into jam yet: the CLI refuses it before
-    getting here.
     """
     from virja.plan.planner import OnlinePlanner
     from virja.routing import Router, RoutingConfig
     from virja.session import Performance
 
-    if animate:
-        raise NotAvailableError("drawing the band is not wired into jam yet; use --headless")
     router = Router(RoutingConfig.from_dict(section(doc, "routing")))
-    return Performance(router=router, planner=OnlinePlanner(), plan_log=plan_log)
+    animator = None
+    if animate:
+        from virja.motion.band import BandAnimator
+
+        animator = BandAnimator()
+    planner = OnlinePlanner(jam_plan_config(config_path, delay_s))
+    return Performance(router=router, planner=planner, animator=animator, plan_log=plan_log)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -163,16 +197,24 @@ def run(args: argparse.Namespace) -> int:
     opts = _options(args, doc)
     if args.list_ports:
         return _list_ports(opts.api)
-    if not args.headless:
-        raise NotAvailableError(
-            "drawing the band in a window is not wired into jam yet; use --headless"
-        )
     send_to = parse_hostport(opts.send) if opts.send else None
 
     api = probe_api(opts.api)
     clock = SessionClock()
     with contextlib.ExitStack() as stack, _plan_log(args.plan_log) as log_fh:
-        perf = build_performance(doc, plan_log=log_fh, animate=not args.headless)
+        perf = build_performance(
+            doc,
+            plan_log=log_fh,
+            animate=not args.headless,
+            delay_s=opts.delay_s,
+            config_path=args.config,
+        )
+        view = None
+        if not args.headless:
+            from virja.render.live import LiveView
+
+            view = LiveView(title="virja jam")
+            stack.callback(view.close)
         thru = None
         if opts.thru is not None:
             thru = MidiOutput(api, opts.thru, clock.now_s)
@@ -198,7 +240,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {keys}: {what}")
         sys.stdout.flush()
 
-        counts = _loop(perf, jam, midi_in, thru, clock.now_s, opts.fps, args.duration)
+        counts = _loop(perf, jam, midi_in, thru, clock.now_s, opts.fps, args.duration, view)
         perf.finish()
     print(
         f"virja jam: {midi_in.received} messages, {counts['bass']} bass and "
@@ -216,6 +258,7 @@ def _loop(
     now_s: Callable[[], float],
     fps: float,
     duration_s: float | None,
+    view: Any = None,
 ) -> dict[str, int]:
     """The live timer: feed what arrived, commit motions, follow ports; until time or Ctrl-C."""
     counts = {"bass": 0, "drums": 0}
@@ -232,11 +275,18 @@ def _loop(
                 counts[performer] += 1
                 perf.feed_routed(performer, arrival.routed.event, now_s=arrival.arrival_s)
             perf.advance(now)
+            if view is not None:
+                view.frame(perf, now)
+                if view.closed:
+                    break
+                if perf.animator is not None:
+                    perf.animator.forget_before(now - 20.0)
             midi_in.poll(now)
             if thru is not None:
                 thru.poll(now)
             if end is not None and now >= end:
                 break
             next_tick = now + tick_s
-            time.sleep(max(0.0, min(next_tick, end or next_tick) - now_s()))
+            if view is None:
+                time.sleep(max(0.0, min(next_tick, end or next_tick) - now_s()))
     return counts

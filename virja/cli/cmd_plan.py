@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from virja.errors import ConfigError
-from virja.events import Beat, NoteOn
+from virja.events import NoteOn
 from virja.plan.types import PlannedNote, PlanReport
 
 PCAP_SUFFIXES = {".pcap", ".pcapng", ".cap"}
@@ -64,30 +64,18 @@ def _plan_midi(
 def _plan_pcap(
     path: Path, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
+    """A recording through the live receiver and planner on its recorded clock."""
     from virja.config import section
+    from virja.input import pcap_input
     from virja.plan import OnlinePlanner, load_plan_config
-    from virja.rmcp.pcap import read_capture
-    from virja.rmcp.receiver import Receiver
     from virja.routing import Router, RoutingConfig
+    from virja.session import Performance, run_schedule
 
-    capture = read_capture(path) if args.port is None else read_capture(path, port=args.port)
-    receiver = Receiver()
-    router = Router(RoutingConfig.from_dict(section(doc, "routing")))
+    routing = RoutingConfig.from_dict(section(doc, "routing"))
+    src = pcap_input(path, routing, port=args.port)
     planner = OnlinePlanner(load_plan_config(args.config))
-    out: list[PlannedNote] = []
-    for dgram in capture.datagrams:
-        receiver.receive_datagram(dgram.payload, dgram.src, now_us=dgram.time_us)
-        for rec in receiver.drain_events():
-            out.extend(planner.poll(rec.arrival_s))
-            ev = rec.event
-            if isinstance(ev, Beat):
-                planner.add_beat(ev)
-                continue
-            who = router.route(ev)
-            if who is not None and isinstance(ev, NoteOn):
-                planner.add_note(who, ev, now_s=rec.arrival_s)
-    out.extend(planner.flush())
-    return out, planner.report
+    perf = Performance(router=Router(routing), planner=planner)
+    return run_schedule(perf, src.schedule), planner.report
 
 
 def _fmt(value: object) -> str:

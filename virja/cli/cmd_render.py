@@ -67,7 +67,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--end", type=float, metavar="SECONDS", help="last frame time (default: the end plus 1.5 s)"
     )
-    p.add_argument("--samples", type=int, default=4, help="multisampling (1 = off; default 4)")
+    p.add_argument(
+        "--samples",
+        type=int,
+        default=1,
+        help="multisample anti-aliasing, 1 (off, default) to 8; 4 looks smoother and renders about 2.5x slower here",
+    )
     p.add_argument(
         "--plan-log", metavar="FILE.jsonl", help="also write the plan, one JSON object per note"
     )
@@ -154,8 +159,8 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
     if args.bvh:
         from virja.motion.export import performance_to_bvh
 
-        performance_to_bvh(animator, t0, t1, args.fps, Path(args.bvh))
-        print(f"wrote {args.bvh}")
+        for path in performance_to_bvh(animator, t0, t1, args.fps, Path(args.bvh)):
+            print(f"wrote {path}")
     rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
     where = out.path if out.kind != "png" or len(result.outputs) != 1 else result.outputs[0]
     print(

@@ -43,7 +43,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--camera", choices=sorted(PRESETS), default="front")
     p.add_argument("--no-audio", action="store_true")
     p.add_argument("--soundfont", metavar="FILE.sf2")
-    p.add_argument("--samples", type=int, default=4)
+    p.add_argument("--samples", type=int, default=1, help="multisampling (default 1 = off)")
     add_routing_arguments(p)
 
 
@@ -73,7 +73,7 @@ def play(src: object, args: argparse.Namespace) -> int:
     from virja.motion.band import BandAnimator
     from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
-    from virja.session import Performance, RevealFeeder
+    from virja.session import Performance, RevealFeeder, run_schedule
 
     assert isinstance(src, PerformanceInput)
     plan_log = open_plan_log(args.plan_log)
@@ -87,11 +87,7 @@ def play(src: object, args: argparse.Namespace) -> int:
     t0, t1 = src.default_span()
     try:
         if args.headless:
-            # virtual clock: jump from reveal to reveal, committing at each
-            for r in src.schedule:
-                feeder.until(perf, r.at_s)
-                perf.advance(r.at_s)
-            feeder.until(perf, math.inf)
+            run_schedule(perf, src.schedule)
         else:
             from virja.render.live import LiveView
             from virja.render.offline import parse_size
@@ -108,7 +104,8 @@ def play(src: object, args: argparse.Namespace) -> int:
                     view.frame(perf, t)
             finally:
                 view.close()
-        perf.finish()
+            feeder.until(perf, math.inf)
+            perf.finish()
     finally:
         if plan_log is not None:
             plan_log.close()

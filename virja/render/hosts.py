@@ -122,7 +122,7 @@ class WindowHost:
         glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 3)
         glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
         glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
-        glfw.window_hint(glfw.SAMPLES, 4)
+        glfw.window_hint(glfw.SAMPLES, 0)  # we draw offscreen (multisampled) and blit
         self.glfw = glfw
         self.title = title
         self.window = glfw.create_window(size[0], size[1], title, None, None)
@@ -131,6 +131,9 @@ class WindowHost:
             raise NotAvailableError("glfw could not open an OpenGL 3.3 window")
         glfw.make_context_current(self.window)
         glfw.swap_interval(0)
+        # GLX (glcontext can attach to a current context only through GLX).  Mesa
+        # refuses a GLX context in a process that already made an EGL one (X
+        # BadAccess), so a process draws either to a window or headless, not both.
         self.ctx = moderngl.create_context(require=330)
         self.state = WindowState()
         self.on_screenshot: Callable[[NDArray[np.uint8]], None] | None = None

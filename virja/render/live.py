@@ -11,7 +11,7 @@ import logging
 import time
 from pathlib import Path
 
-from virja.render.hosts import WindowHost
+from virja.render.hosts import OffscreenTarget, WindowHost
 from virja.render.images import write_png
 from virja.render.renderer import DrawList, Renderer
 from virja.render.scene import band_scene, static_scene
@@ -23,8 +23,12 @@ log = logging.getLogger(__name__)
 class LiveView:
     """A window showing a performance; call :meth:`frame` as often as you like."""
 
-    def __init__(self, size: tuple[int, int] = (1280, 720), title: str = "virja") -> None:
+    def __init__(
+        self, size: tuple[int, int] = (1280, 720), title: str = "virja", samples: int = 1
+    ) -> None:
         self.host = WindowHost(size, title)
+        self.samples = samples
+        self.target: OffscreenTarget | None = None
         self.renderer = Renderer(self.host.ctx)
         self.static: DrawList = static_scene()
         self.host.on_screenshot = self._save_screenshot
@@ -45,8 +49,15 @@ class LiveView:
         return self.host.should_close
 
     def frame(self, perf: Performance, time_s: float) -> None:
+        """Draw the band at ``time_s`` offscreen, copy it to the window, show it."""
         fb = self.host.framebuffer()
-        self.renderer.draw([self.static, band_scene(perf.pose(time_s))], self.host.state.camera, fb)
+        if self.target is None or self.target.size != fb.size:
+            if self.target is not None:
+                self.target.release()
+            self.target = OffscreenTarget(self.host.ctx, fb.size, samples=self.samples)
+        pose = perf.pose(time_s)
+        self.renderer.draw([self.static, band_scene(pose)], self.host.state.camera, self.target.fbo)
+        self.host.ctx.copy_framebuffer(fb, self.target.fbo)
         self._fps_frames += 1
         now = time.perf_counter()
         if now - self._fps_since >= 1.0:
@@ -56,5 +67,7 @@ class LiveView:
         self.host.present(self.fps if self.fps else None)
 
     def close(self) -> None:
+        if self.target is not None:
+            self.target.release()
         self.renderer.release()
         self.host.close()

@@ -123,7 +123,9 @@ def sphere_transforms(center: ArrayLike, radius: ArrayLike) -> F64:
     return m
 
 
-def disc_transforms(center: ArrayLike, normal: ArrayLike, radius: ArrayLike, thickness: ArrayLike) -> F64:
+def disc_transforms(
+    center: ArrayLike, normal: ArrayLike, radius: ArrayLike, thickness: ArrayLike
+) -> F64:
     """Flat cylinders (drum heads, cymbals) centred at ``center``, axis ``normal``."""
     c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(normal, dtype=np.float64).reshape(-1, 3)
@@ -136,7 +138,9 @@ def box_transforms(center: ArrayLike, size: ArrayLike, rotation: ArrayLike | Non
     """Box instances: centre (n, 3), full size (n, 3), optional rotation (n, 3, 3)."""
     c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
     s = np.asarray(size, dtype=np.float64).reshape(-1, 3)
-    rot = np.broadcast_to(np.eye(3), (c.shape[0], 3, 3)) if rotation is None else np.asarray(rotation)
+    rot = (
+        np.broadcast_to(np.eye(3), (c.shape[0], 3, 3)) if rotation is None else np.asarray(rotation)
+    )
     m = np.zeros((c.shape[0], 4, 4))
     m[:, :3, :3] = rot * s[:, None, :]
     m[:, :3, 3] = c

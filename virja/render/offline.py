@@ -33,7 +33,7 @@ VIDEO_SUFFIXES = frozenset({".mp4", ".mkv", ".mov"})
 
 
 def parse_size(text: str) -> tuple[int, int]:
-    """"1280x720" -> (1280, 720)."""
+    """ "1280x720" -> (1280, 720)."""
     try:
         w, h = (int(x) for x in text.lower().split("x"))
     except ValueError as exc:

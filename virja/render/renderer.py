@@ -55,6 +55,10 @@ class DrawList:
             return _EMPTY
         return pack_instances(np.concatenate(self.models[kind]), np.concatenate(self.colors[kind]))
 
+    @property
+    def frozen(self) -> bool:
+        return self._frozen is not None
+
     def freeze(self) -> DrawList:
         """Pack once and reuse (for the static stage and instruments)."""
         self._frozen = {k: self.packed(k) for k in self.models}
@@ -74,6 +78,8 @@ class Renderer:
         self._ibos: dict[str, moderngl.Buffer] = {}
         self._vaos: dict[str, moderngl.VertexArray] = {}
         self._capacity: dict[str, int] = {}
+        self._layer: moderngl.Framebuffer | None = None
+        self._layer_key: tuple[object, ...] | None = None
         for kind, make in MESHES.items():
             mesh = make()
             self._vbos[kind] = ctx.buffer(mesh.tobytes())
@@ -99,23 +105,73 @@ class Renderer:
         camera: Camera,
         fbo: moderngl.Framebuffer,
     ) -> None:
-        """Clear ``fbo`` and draw every instance of the list(s) as seen by ``camera``."""
+        """Clear ``fbo`` and draw every instance of the list(s) as seen by ``camera``.
+
+        When the first list is frozen (the static stage), it is drawn once into a
+        cached colour + depth layer for this camera and size, and each frame starts
+        from a copy of that layer: only what moves is drawn again.  On a CPU
+        rasteriser this saves most of the frame (the floor and the instruments
+        cover far more pixels than the players).
+        """
         lists = [draw_list] if isinstance(draw_list, DrawList) else list(draw_list)
+        self._begin(camera, fbo)
+        if lists and lists[0].frozen:
+            layer = self._static_layer(lists[0], camera, fbo)
+            self.ctx.copy_framebuffer(fbo, layer)
+            fbo.use()
+            lists = lists[1:]
+        else:
+            fbo.clear(*BACKGROUND, 1.0, depth=1.0)
+        self._draw_instances(lists)
+
+    def _begin(self, camera: Camera, fbo: moderngl.Framebuffer) -> None:
         w, h = fbo.size
         fbo.use()
         self.ctx.viewport = (0, 0, w, h)
-        fbo.clear(*BACKGROUND, 1.0, depth=1.0)
         self.ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         vp = camera.view_proj(w / max(h, 1))
         self._uniform("u_view_proj").write(vp.T.astype("f4").tobytes())
-        eye = camera.eye
-        self._set("u_eye", tuple(float(x) for x in eye))
+        self._set("u_eye", tuple(float(x) for x in camera.eye))
         self._set("u_key_dir", _unit((0.35, 0.85, 0.55)))
         self._set("u_fill_dir", _unit((-0.6, 0.3, 0.4)))
         self._set("u_spot_pos", (0.0, 3.2, 1.6))
         self._set("u_fog_color", BACKGROUND)
+
+    def _static_layer(
+        self, static: DrawList, camera: Camera, fbo: moderngl.Framebuffer
+    ) -> moderngl.Framebuffer:
+        samples = fbo.samples
+        key = (id(static), camera, fbo.size, samples)
+        if self._layer is not None and self._layer_key == key:
+            return self._layer
+        if self._layer is None or (self._layer.size, self._layer.samples) != (fbo.size, samples):
+            self._release_layer()
+            self._layer = self.ctx.framebuffer(
+                color_attachments=[self.ctx.renderbuffer(fbo.size, samples=samples)],
+                depth_attachment=self.ctx.depth_renderbuffer(fbo.size, samples=samples),
+            )
+        self._layer.use()
+        self._layer.clear(*BACKGROUND, 1.0, depth=1.0)
+        self._draw_instances([static])
+        self._layer_key = key
+        fbo.use()
+        return self._layer
+
+    def _release_layer(self) -> None:
+        if self._layer is None:
+            return
+        for att in self._layer.color_attachments:
+            att.release()
+        if self._layer.depth_attachment is not None:
+            self._layer.depth_attachment.release()
+        self._layer.release()
+        self._layer = None
+
+    def _draw_instances(self, lists: Sequence[DrawList]) -> None:
         for kind in MESHES:
             parts = [d.packed(kind) for d in lists]
+            if not parts:
+                continue
             data = parts[0] if len(parts) == 1 else np.concatenate(parts)
             n = len(data)
             if n == 0:
@@ -135,6 +191,7 @@ class Renderer:
             self._uniform(name).value = value
 
     def release(self) -> None:
+        self._release_layer()
         for d in (self._vaos, self._ibos, self._vbos):
             for obj in d.values():
                 obj.release()

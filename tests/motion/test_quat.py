@@ -1,0 +1,140 @@
+"""Quaternion convention (w x y z), slerp edge cases and the pyrr regression."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from virja.motion import quat as Q
+
+RNG = np.random.default_rng(7)
+
+
+def _rand(n: int) -> np.ndarray:
+    return Q.normalize(RNG.normal(size=(n, 4)))
+
+
+def test_multiply_matches_matrix_product() -> None:
+    a, b = _rand(50), _rand(50)
+    np.testing.assert_allclose(
+        Q.to_matrix(Q.multiply(a, b)), Q.to_matrix(a) @ Q.to_matrix(b), atol=1e-12
+    )
+
+
+def test_rotate_matches_matrix() -> None:
+    q = _rand(20)
+    v = RNG.normal(size=(20, 3))
+    np.testing.assert_allclose(
+        Q.rotate(q, v), np.einsum("nij,nj->ni", Q.to_matrix(q), v), atol=1e-12
+    )
+
+
+def test_axis_angle_is_scalar_first() -> None:
+    q = Q.from_axis_angle([0, 0, 1], np.pi / 2)
+    np.testing.assert_allclose(q, [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)])
+    np.testing.assert_allclose(Q.rotate(q, [1.0, 0, 0]), [0, 1, 0], atol=1e-12)
+
+
+def test_axis_angle_round_trip() -> None:
+    q = _rand(30)
+    axis, ang = Q.to_axis_angle(q)
+    assert np.all(Q.angle_between(Q.from_axis_angle(axis, ang), q) < 1e-9)
+
+
+def test_matrix_round_trip() -> None:
+    q = _rand(100)
+    assert np.all(Q.angle_between(Q.from_matrix(Q.to_matrix(q)), q) < 1e-9)
+
+
+def test_inverse_undoes_rotation() -> None:
+    q = _rand(10)
+    np.testing.assert_allclose(Q.multiply(q, Q.inverse(q)), Q.identity((10,)), atol=1e-12)
+
+
+@pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
+def test_euler_round_trip_every_order(order: str) -> None:
+    q = _rand(200)
+    assert np.all(Q.angle_between(Q.from_euler(Q.to_euler(q, order), order), q) < 1e-9)
+
+
+def test_euler_zxy_is_rz_rx_ry() -> None:
+    """BVH 'Zrotation Xrotation Yrotation' means R = Rz @ Rx @ Ry."""
+    z, x, y = 0.3, -0.7, 1.1
+    q = Q.from_euler([z, x, y], "ZXY")
+    want = Q.multiply(
+        Q.multiply(Q.from_axis_angle([0, 0, 1], z), Q.from_axis_angle([1, 0, 0], x)),
+        Q.from_axis_angle([0, 1, 0], y),
+    )
+    assert Q.angle_between(q, want) < 1e-12
+
+
+def test_euler_gimbal_lock_round_trip() -> None:
+    q = Q.from_euler([[0.4, np.pi / 2, -0.3], [0.2, -np.pi / 2, 0.5]], "ZXY")
+    back = Q.from_euler(Q.to_euler(q, "ZXY"), "ZXY")
+    assert np.all(Q.angle_between(back, q) < 1e-7)
+
+
+def test_slerp_endpoints_and_midpoint() -> None:
+    a = Q.from_axis_angle([0, 1, 0], 0.2)
+    b = Q.from_axis_angle([0, 1, 0], 1.0)
+    assert Q.angle_between(Q.slerp(a, b, 0.0), a) < 1e-12
+    assert Q.angle_between(Q.slerp(a, b, 1.0), b) < 1e-12
+    assert Q.angle_between(Q.slerp(a, b, 0.5), Q.from_axis_angle([0, 1, 0], 0.6)) < 1e-12
+
+
+def test_slerp_antipodal_takes_short_way() -> None:
+    """b given as -b (same rotation): the path must not swing through 180 degrees."""
+    a = Q.from_axis_angle([1, 0, 0], 0.0)
+    b = -Q.from_axis_angle([1, 0, 0], 0.8)
+    mid = Q.slerp(a, b, 0.5)
+    assert abs(Q.angle(mid) - 0.4) < 1e-12
+
+
+def test_slerp_pyrr_regression_near_parallel_negative_dot() -> None:
+    """pyrr's near-parallel fallback forgets the sign flip: a 0.1 rad step became ~171 deg.
+
+    With a = identity and b = -(0.1 rad about z), every point of our slerp is
+    within 0.1 rad of a (pyrr.quaternion.slerp lerps a and the *unflipped* b).
+    """
+    a = Q.identity()
+    b = -Q.from_axis_angle([0, 0, 1], 0.1)
+    ts = np.linspace(0.0, 1.0, 11)
+    path = Q.slerp(a, b, ts)
+    angles = Q.angle_between(path, a)
+    assert np.all(angles <= 0.1 + 1e-12)
+    np.testing.assert_allclose(angles, 0.1 * ts, atol=1e-9)
+
+
+def test_slerp_tiny_angle_is_finite_and_unit() -> None:
+    a = Q.from_axis_angle([0, 0, 1], 1e-9)
+    b = Q.from_axis_angle([0, 0, 1], 3e-9)
+    m = Q.slerp(a, b, 0.5)
+    assert np.all(np.isfinite(m))
+    assert abs(np.linalg.norm(m) - 1.0) < 1e-12
+    assert Q.angle_between(m, Q.from_axis_angle([0, 0, 1], 2e-9)) < 1e-12
+
+
+def test_slerp_identical_inputs() -> None:
+    q = _rand(5)
+    np.testing.assert_allclose(Q.slerp(q, q, 0.3), q, atol=1e-12)
+
+
+def test_slerp_broadcasts_over_frames_and_joints() -> None:
+    a = _rand(12).reshape(3, 4, 4)
+    b = _rand(12).reshape(3, 4, 4)
+    t = np.linspace(0, 1, 3)[:, None]
+    out = Q.slerp(a, b, t)
+    assert out.shape == (3, 4, 4)
+    assert Q.angle_between(out[2], b[2]).max() < 1e-9
+
+
+def test_from_two_vectors_including_opposite() -> None:
+    for a, b in [([1, 0, 0], [0, 1, 0]), ([0, 0, 1], [0, 0, -1]), ([1, 2, 3], [1, 2, 3])]:
+        q = Q.from_two_vectors(a, b)
+        r = Q.rotate(q, np.array(a, dtype=float) / np.linalg.norm(a))
+        np.testing.assert_allclose(r, np.array(b, dtype=float) / np.linalg.norm(b), atol=1e-12)
+
+
+def test_bad_shape_raises_value_error() -> None:
+    with pytest.raises(ValueError, match="last axis of 4"):
+        Q.multiply(np.zeros(3), np.zeros(4))

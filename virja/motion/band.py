@@ -1,0 +1,392 @@
+"""``BandAnimator``: planned notes in, a :class:`~virja.motion.pose.BandPose` out.
+
+Each planned note becomes clip instances on limb timelines
+(:mod:`virja.motion.timeline`): a drum note one instance on its limb; a bass
+note a right-hand pluck and, for a stopped note, a left-hand hold at its
+string and fret.  Each figure has an idle base layer (its rest pose, with the
+head nodding on the beat); limbs are combined by joint masks over it, so the
+drummer's two hands and two feet and the bassist's two hands move
+independently.  Both figures share one skeleton, so FK runs once for both.
+"""
+
+from __future__ import annotations
+
+import bisect
+import logging
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from virja.events import Beat
+from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, DRUM_PIECES, GEOMETRY, Geometry
+from virja.motion import quat
+from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
+from virja.motion.pose import BandPose, FigurePose
+from virja.motion.skeleton import (
+    LIMB_JOINTS,
+    SKELETON,
+    STICK_AXIS_LOCAL,
+    STICK_BUTT_M,
+    STICK_TIP_M,
+)
+from virja.motion.timeline import Instance, Timeline
+
+log = logging.getLogger(__name__)
+
+FIGURES = ("drums", "bass")
+FIGURE_LIMBS = {
+    "drums": ("left_hand", "right_hand", "left_foot", "right_foot"),
+    "bass": ("left_hand", "right_hand"),
+}
+_SK = SKELETON
+_NECK = _SK.index("Neck")
+_HEAD = _SK.index("Head")
+
+
+class PlannedNoteLike(Protocol):
+    """The fields of ``virja.plan.types.PlannedNote`` the animator reads (read-only)."""
+
+    @property
+    def time(self) -> float: ...
+
+    @property
+    def performer(self) -> str: ...
+
+    @property
+    def velocity(self) -> int: ...
+
+    @property
+    def limb(self) -> str: ...
+
+    @property
+    def piece(self) -> str | None: ...
+
+    @property
+    def string(self) -> str | None: ...
+
+    @property
+    def fret(self) -> int | None: ...
+
+    @property
+    def motion(self) -> str: ...
+
+    @property
+    def start(self) -> float: ...
+
+    @property
+    def impact(self) -> float: ...
+
+
+@dataclass(frozen=True)
+class AnimationSettings:
+    """Constants from motions/animation.toml (see the comments there)."""
+
+    vel_floor: float = 0.4
+    vel_ceiling: float = 1.25
+    reference_spb: float = 0.5
+    max_rate: float = 2.0
+    nod_rad: float = 0.06
+    sway_rad: float = 0.025
+    sway_period_s: float = 4.0
+    head_decay_s: float = 0.15
+    swing: tuple[tuple[str, float, float, float], ...] = (
+        ("ride", 0.08, 1.0, 1.6),
+        ("crash", 0.15, 1.5, 1.2),
+        ("hihat", 0.03, 0.3, 3.0),
+    )
+    hihat_travel_m: float = 0.04
+    string_amp_m: float = 0.004
+    string_decay_s: float = 1.2
+
+    @classmethod
+    def load(cls, path: Path | None = None) -> AnimationSettings:
+        if path is None:
+            from virja.resources import motions_dir
+
+            path = motions_dir() / "animation.toml"
+        if not path.is_file():
+            return cls()
+        d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
+        k = d.get("kit", {})
+        return cls(
+            vel_floor=d["velocity"]["floor"],
+            vel_ceiling=d["velocity"]["ceiling"],
+            reference_spb=d["tempo"]["reference_spb"],
+            max_rate=d["tempo"]["max_rate"],
+            nod_rad=d["idle"]["nod_rad"],
+            sway_rad=d["idle"]["sway_rad"],
+            sway_period_s=d["idle"]["sway_period_s"],
+            head_decay_s=k["head_decay_s"],
+            swing=tuple(_swing(p, k[f"{p}_swing"]) for p in ("ride", "crash", "hihat")),
+            hihat_travel_m=k["hihat_travel_m"],
+            string_amp_m=d["strings"]["amplitude_m"],
+            string_decay_s=d["strings"]["decay_s"],
+        )
+
+
+def _swing(piece: str, v: list[float]) -> tuple[str, float, float, float]:
+    return (piece, float(v[0]), float(v[1]), float(v[2]))
+
+
+@dataclass(frozen=True)
+class Hit:
+    """An impact for the kit/string state: ``what`` is a piece or a string name."""
+
+    time: float
+    what: str
+    velocity: int
+
+
+class BandAnimator:
+    """Turns planned notes and beats into poses.  Not thread-safe; one per session."""
+
+    def __init__(
+        self,
+        library: MotionLibrary | None = None,
+        geometry: Geometry = GEOMETRY,
+        settings: AnimationSettings | None = None,
+    ) -> None:
+        self.library = library if library is not None else default_library()
+        self.geometry = geometry
+        self.settings = settings or AnimationSettings.load()
+        self.idle: dict[str, Clip] = {f: self.library[f"idle_{f}"] for f in FIGURES}
+        self.timelines: dict[tuple[str, str], Timeline] = {
+            (f, limb): Timeline(_SK.mask(LIMB_JOINTS[limb]).nonzero()[0])
+            for f in FIGURES
+            for limb in FIGURE_LIMBS[f]
+        }
+        self._roots = np.stack([self.idle[f].root_positions[0] for f in FIGURES])
+        self._beat_times: list[float] = []
+        self._beat_spb: list[float] = []
+        self._hits: list[Hit] = []
+        self._hit_times: list[float] = []
+        pedal = geometry.kit.hihat_pedal
+        self._hihat_pressed_y = float(pedal.toe_point(True)[1])
+        self._ltoe = _SK.index("LeftToe")
+
+    # ------------------------------------------------------------------ input
+
+    def seconds_per_beat_at(self, time_s: float) -> float:
+        """The tempo from the latest beat at or before ``time_s`` (default 120 bpm)."""
+        i = bisect.bisect_right(self._beat_times, time_s) - 1
+        return self._beat_spb[max(i, 0)] if self._beat_spb else self.settings.reference_spb
+
+    def add_beat(self, beat: Beat) -> None:
+        """Record a beat: the idle layer nods on it and the tempo sets the rebound speed."""
+        i = bisect.bisect_right(self._beat_times, beat.time_s)
+        self._beat_times.insert(i, beat.time_s)
+        self._beat_spb.insert(i, beat.seconds_per_beat)
+
+    def velocity_scale(self, velocity: int, nominal: int) -> float:
+        s = self.settings
+        v = s.vel_floor + (1.0 - s.vel_floor) * velocity / max(nominal, 1)
+        return float(min(max(v, s.vel_floor), s.vel_ceiling))
+
+    def _rate(self, time_s: float) -> float:
+        s = self.settings
+        return float(min(max(s.reference_spb / self.seconds_per_beat_at(time_s), 1.0), s.max_rate))
+
+    def add_planned(self, p: PlannedNoteLike) -> None:
+        """Schedule the motions of one planned note (its start and impact are kept exactly).
+
+        Raises :class:`UnknownMotionError` when the library lacks the motion.
+        """
+        rate = self._rate(p.impact)
+        if p.performer == "drums":
+            clip = self.library[p.motion]
+            limb = clip.limb or p.limb
+            if clip.performer != "drums" or limb not in FIGURE_LIMBS["drums"]:
+                raise UnknownMotionError(f"{p.motion!r} is not a drummer's limb motion")
+            self.timelines[("drums", limb)].add(
+                Instance(
+                    clip,
+                    p.start,
+                    p.impact,
+                    rate,
+                    self.velocity_scale(p.velocity, clip.velocity),
+                    p.velocity,
+                    tag=p,
+                )
+            )
+            self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
+        elif p.performer == "bass":
+            if p.string not in BASS_STRINGS:
+                raise UnknownMotionError(f"bass note without a known string: {p.string!r}")
+            pluck = self.library[f"pluck_{p.string}"]
+            self.timelines[("bass", "right_hand")].add(
+                Instance(
+                    pluck,
+                    p.start,
+                    p.impact,
+                    rate,
+                    self.velocity_scale(p.velocity, pluck.velocity),
+                    p.velocity,
+                    tag=p,
+                )
+            )
+            left = self.timelines[("bass", "left_hand")]
+            fret = p.fret or 0
+            if fret > 0:
+                left.add(self._hold(f"fret_{p.string}_{fret}", p))
+            else:
+                current = left.active(p.start)
+                if current and current[-1].clip.string == p.string:
+                    left.add(self._hold("fret_open", p))
+            self._add_hit(Hit(p.impact, p.string, p.velocity))
+        else:
+            raise UnknownMotionError(f"no figure for performer {p.performer!r}")
+
+    def _hold(self, name: str, p: PlannedNoteLike) -> Instance:
+        # a hold with no predecessor fades in from the rest pose over its preparation
+        return Instance(
+            self.library[name], p.start, p.impact, fade_in=max(p.impact - p.start, 1e-3), tag=p
+        )
+
+    def _add_hit(self, h: Hit) -> None:
+        i = bisect.bisect_right(self._hit_times, h.time)
+        self._hit_times.insert(i, h.time)
+        self._hits.insert(i, h)
+
+    def forget_before(self, time_s: float) -> None:
+        """Drop what can no longer show at ``time_s`` or later (bounds memory in long sessions)."""
+        for tl in self.timelines.values():
+            tl.forget_before(time_s)
+        horizon = time_s - 10.0  # kit and string states have died away long before
+        k = bisect.bisect_left(self._hit_times, horizon)
+        del self._hits[:k]
+        del self._hit_times[:k]
+        k = max(bisect.bisect_right(self._beat_times, time_s) - 1, 0)
+        del self._beat_times[:k]
+        del self._beat_spb[:k]
+
+    # ------------------------------------------------------------------ output
+
+    def local_rotations(self, time_s: float) -> np.ndarray:
+        """Local rotations (2, n_joints, 4) of [drums, bass] at ``time_s``, w x y z."""
+        out = np.empty((2, _SK.n_joints, 4))
+        nod = self._nod(time_s)
+        for fi, f in enumerate(FIGURES):
+            idle = self.idle[f]
+            loc = out[fi]
+            loc[:] = idle.rotations[0]
+            loc[_NECK] = quat.multiply(loc[_NECK], nod[0])
+            loc[_HEAD] = quat.multiply(loc[_HEAD], nod[1])
+            for limb in FIGURE_LIMBS[f]:
+                tl = self.timelines[(f, limb)]
+                if len(tl):
+                    loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
+        return out
+
+    def _nod(self, t: float) -> np.ndarray:
+        s = self.settings
+        i = bisect.bisect_right(self._beat_times, t) - 1
+        if i >= 0:
+            spb = self._beat_spb[i]
+            phase = (t - self._beat_times[i]) / spb
+        else:
+            spb = s.reference_spb
+            phase = t / spb
+        phase = min(phase, 1.0) if i >= 0 else phase % 1.0
+        nod = s.nod_rad * math.sin(math.pi * phase) ** 2
+        sway = s.sway_rad * math.sin(2 * math.pi * t / s.sway_period_s)
+        return np.array(
+            [
+                [math.cos(nod / 2), math.sin(nod / 2), 0.0, 0.0],
+                [math.cos(sway / 2), 0.0, math.sin(sway / 2), 0.0],
+            ]
+        )
+
+    def pose(self, time_s: float) -> BandPose:
+        """The band at ``time_s`` (session seconds)."""
+        loc = self.local_rotations(time_s)
+        wpos, wrot = _SK.fk(loc, self._roots)
+        figs = [FigurePose(_SK.names, _SK.parents, wpos[i], wrot[i], _SK.radii) for i in range(2)]
+        return BandPose(
+            time_s=time_s,
+            drums=figs[0],
+            bass=figs[1],
+            sticks=sticks(wpos[0], wrot[0]),
+            hihat_open=self._hihat_open(wpos[0]),
+            cymbal_swing=self._swings(time_s),
+            head_hits=self._head_hits(time_s),
+            string_vibration=self._strings(time_s),
+            string_stops=self._stops(time_s),
+            fretting_tip=wpos[1, _SK.index("LeftHandEnd")].copy(),
+            plucking_tip=wpos[1, _SK.index("RightHandEnd")].copy(),
+        )
+
+    def _recent(self, t: float, window: float) -> list[Hit]:
+        lo = bisect.bisect_left(self._hit_times, t - window)
+        hi = bisect.bisect_right(self._hit_times, t)
+        return self._hits[lo:hi]
+
+    def _hihat_open(self, wpos: np.ndarray) -> float:
+        rise = float(wpos[self._ltoe, 1]) - self._hihat_pressed_y
+        return float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
+
+    def _swings(self, t: float) -> dict[str, float]:
+        out = {}
+        recent = self._recent(t, 8.0)
+        for piece, amp, tau, freq in self.settings.swing:
+            a = 0.0
+            for h in recent:
+                if h.what == piece:
+                    dt = t - h.time
+                    a += (
+                        amp
+                        * h.velocity
+                        / 127
+                        * math.exp(-dt / tau)
+                        * math.sin(2 * math.pi * freq * dt)
+                    )
+            out[piece] = a
+        return out
+
+    def _head_hits(self, t: float) -> dict[str, float]:
+        out = dict.fromkeys(DRUM_PIECES, 0.0)
+        tau = self.settings.head_decay_s
+        for h in self._recent(t, 8 * tau):
+            if h.what in out:
+                out[h.what] = max(out[h.what], h.velocity / 127 * math.exp(-(t - h.time) / tau))
+        return out
+
+    def _strings(self, t: float) -> dict[str, float]:
+        out = dict.fromkeys(BASS_STRINGS, 0.0)
+        s = self.settings
+        latest: dict[str, Hit] = {}
+        for h in self._recent(t, 8 * s.string_decay_s):
+            if h.what in out:
+                latest[h.what] = h
+        for name, h in latest.items():
+            out[name] = (
+                s.string_amp_m * h.velocity / 127 * math.exp(-(t - h.time) / s.string_decay_s)
+            )
+        return out
+
+    def _stops(self, t: float) -> dict[str, int]:
+        out = dict.fromkeys(BASS_STRINGS, 0)
+        act = self.timelines[("bass", "left_hand")].active(t)
+        for inst in reversed(act):
+            if inst.impact <= t:
+                if inst.clip.string is not None and inst.clip.fret:
+                    out[inst.clip.string] = inst.clip.fret
+                break
+        return out
+
+
+def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:
+    """(2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result."""
+    out = np.empty((2, 2, 3))
+    for i, side in enumerate(("Left", "Right")):
+        grip = wpos[_SK.index(f"{side}HandEnd")]
+        axis = quat.rotate(wrot[_SK.index(f"{side}Hand")], STICK_AXIS_LOCAL)
+        out[i, 0] = grip - STICK_BUTT_M * axis
+        out[i, 1] = grip + STICK_TIP_M * axis
+    return out
+
+
+__all__ = ["BandAnimator", "AnimationSettings", "PlannedNoteLike", "sticks", "CYMBAL_PIECES"]

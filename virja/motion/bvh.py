@@ -1,0 +1,345 @@
+"""BVH (Biovision hierarchy) reading and writing.
+
+A :class:`Bvh` holds the hierarchy (joint names, parents, rest offsets,
+channel orders, end sites) and the frames converted to our convention:
+
+- ``rotations``: (n_frames, n_joints, 4) float64 local rotations, w x y z
+  (see :mod:`virja.motion.quat`); the Euler channels of each joint are read
+  in the file's own order (``Zrotation Xrotation Yrotation`` -> ``R = Rz Rx Ry``);
+- ``positions``: (n_frames, n_joints, 3) float64 local translations in the
+  file's units: the position channels where a joint has them (the root's
+  translation), its OFFSET otherwise.
+
+Angles in the file are degrees.  A malformed file raises
+:class:`BvhError` (an :class:`~virja.errors.InputFileError`) naming the file
+and the line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from virja.errors import InputFileError
+from virja.motion import quat
+
+_ROT = {"Xrotation": "X", "Yrotation": "Y", "Zrotation": "Z"}
+_POS = {"Xposition": 0, "Yposition": 1, "Zposition": 2}
+
+
+class BvhError(InputFileError):
+    """A BVH file is malformed; the message names the file and the line."""
+
+    def __init__(self, path: object, line: int, reason: str) -> None:
+        self.line = line
+        super().__init__(path, f"line {line}: {reason}")
+
+
+@dataclass(frozen=True)
+class BvhJoint:
+    """One joint: ``parent`` index (-1 for the root), rest ``offset`` (3,), ``channels``."""
+
+    name: str
+    parent: int
+    offset: tuple[float, float, float]
+    channels: tuple[str, ...]
+    end_site: tuple[float, float, float] | None = None
+
+    @property
+    def rotation_order(self) -> str:
+        """Axes of the rotation channels in file order, e.g. ``"ZXY"`` ("" if none)."""
+        return "".join(_ROT[c] for c in self.channels if c in _ROT)
+
+
+@dataclass
+class Bvh:
+    """A BVH file in memory (see the module docstring for shapes and units)."""
+
+    joints: list[BvhJoint]
+    frame_time_s: float
+    rotations: np.ndarray
+    positions: np.ndarray
+    source: str = field(default="<memory>")
+
+    @property
+    def names(self) -> list[str]:
+        return [j.name for j in self.joints]
+
+    @property
+    def parents(self) -> np.ndarray:
+        return np.array([j.parent for j in self.joints], dtype=np.int64)
+
+    @property
+    def offsets(self) -> np.ndarray:
+        return np.array([j.offset for j in self.joints], dtype=np.float64)
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.rotations.shape[0])
+
+    def __post_init__(self) -> None:
+        n = len(self.joints)
+        if self.rotations.ndim != 3 or self.rotations.shape[1:] != (n, 4):
+            raise ValueError(f"rotations must be (n_frames, {n}, 4), got {self.rotations.shape}")
+        if self.positions.shape != self.rotations.shape[:2] + (3,):
+            raise ValueError(f"positions must be (n_frames, {n}, 3), got {self.positions.shape}")
+        if not self.frame_time_s > 0:
+            raise ValueError(f"frame time must be > 0 s, got {self.frame_time_s}")
+
+
+class _Tokens:
+    """Whitespace tokens with their 1-based line numbers."""
+
+    def __init__(self, path: str, lines: list[str], start: int, end: int) -> None:
+        self.path = path
+        self._items: list[tuple[str, int]] = []
+        for n in range(start, end):
+            for tok in lines[n].split():
+                self._items.append((tok, n + 1))
+        self._i = 0
+        self._last_line = end if end > 0 else 1
+
+    def next(self, what: str) -> tuple[str, int]:
+        if self._i >= len(self._items):
+            raise BvhError(
+                self.path, self._last_line, f"unexpected end of hierarchy, expected {what}"
+            )
+        item = self._items[self._i]
+        self._i += 1
+        return item
+
+    def expect(self, word: str) -> int:
+        tok, line = self.next(repr(word))
+        if tok != word:
+            raise BvhError(self.path, line, f"expected {word!r}, got {tok!r}")
+        return line
+
+    def number(self, what: str) -> float:
+        tok, line = self.next(what)
+        try:
+            return float(tok)
+        except ValueError:
+            raise BvhError(self.path, line, f"expected a number for {what}, got {tok!r}") from None
+
+    def peek(self) -> str | None:
+        return self._items[self._i][0] if self._i < len(self._items) else None
+
+
+def _parse_joint(tk: _Tokens, name: str, parent: int, joints: list[BvhJoint]) -> None:
+    tk.expect("{")
+    tk.expect("OFFSET")
+    offset = (tk.number("OFFSET x"), tk.number("OFFSET y"), tk.number("OFFSET z"))
+    tok, line = tk.next("CHANNELS")
+    if tok != "CHANNELS":
+        raise BvhError(tk.path, line, f"expected 'CHANNELS' in joint {name!r}, got {tok!r}")
+    count_tok, line = tk.next("channel count")
+    if not count_tok.isdigit():
+        raise BvhError(tk.path, line, f"expected a channel count, got {count_tok!r}")
+    channels: list[str] = []
+    for _ in range(int(count_tok)):
+        ch, line = tk.next("a channel name")
+        if ch not in _ROT and ch not in _POS:
+            raise BvhError(tk.path, line, f"unknown channel {ch!r} in joint {name!r}")
+        channels.append(ch)
+    rot = [c for c in channels if c in _ROT]
+    if rot and len(rot) != 3:
+        raise BvhError(
+            tk.path, line, f"joint {name!r} needs 0 or 3 rotation channels, has {len(rot)}"
+        )
+    index = len(joints)
+    joints.append(BvhJoint(name, parent, offset, tuple(channels)))
+    while True:
+        tok, line = tk.next("'JOINT', 'End' or '}'")
+        if tok == "}":
+            return
+        if tok == "JOINT":
+            child, _ = tk.next("a joint name")
+            _parse_joint(tk, child, index, joints)
+        elif tok == "End":
+            tk.expect("Site")
+            tk.expect("{")
+            tk.expect("OFFSET")
+            end = (tk.number("End Site x"), tk.number("End Site y"), tk.number("End Site z"))
+            tk.expect("}")
+            j = joints[index]
+            joints[index] = BvhJoint(j.name, j.parent, j.offset, j.channels, end)
+        else:
+            raise BvhError(tk.path, line, f"expected 'JOINT', 'End' or '}}', got {tok!r}")
+
+
+def parse_bvh(text: str, path: str = "<string>") -> Bvh:
+    """Parse BVH text; errors name ``path`` and the line."""
+    lines = text.splitlines()
+    motion_at = next((i for i, ln in enumerate(lines) if ln.strip() == "MOTION"), None)
+    if motion_at is None:
+        raise BvhError(path, max(len(lines), 1), "no MOTION section")
+    tk = _Tokens(path, lines, 0, motion_at)
+    tk.expect("HIERARCHY")
+    tok, line = tk.next("'ROOT'")
+    if tok != "ROOT":
+        raise BvhError(path, line, f"expected 'ROOT', got {tok!r}")
+    name, _ = tk.next("the root's name")
+    joints: list[BvhJoint] = []
+    _parse_joint(tk, name, -1, joints)
+    if tk.peek() is not None:
+        tok, line = tk.next("end")
+        raise BvhError(path, line, f"only one ROOT is supported, got {tok!r} after it")
+    names = [j.name for j in joints]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise BvhError(path, 1, f"duplicate joint names {sorted(dup)}")
+
+    n_frames, frame_time, first = _motion_header(lines, motion_at, path)
+    n_channels = sum(len(j.channels) for j in joints)
+    data = np.empty((n_frames, n_channels), dtype=np.float64)
+    row = 0
+    for i in range(first, len(lines)):
+        s = lines[i].split()
+        if not s:
+            continue
+        if row >= n_frames:
+            raise BvhError(path, i + 1, f"more frame lines than 'Frames: {n_frames}'")
+        if len(s) != n_channels:
+            raise BvhError(
+                path, i + 1, f"frame has {len(s)} values, the hierarchy has {n_channels} channels"
+            )
+        try:
+            data[row] = [float(x) for x in s]
+        except ValueError:
+            raise BvhError(path, i + 1, "frame values must be numbers") from None
+        row += 1
+    if row != n_frames:
+        raise BvhError(path, len(lines), f"'Frames: {n_frames}' but {row} frame lines")
+    rotations, positions = _channels_to_arrays(joints, data)
+    return Bvh(joints, frame_time, rotations, positions, source=path)
+
+
+def _motion_header(lines: list[str], motion_at: int, path: str) -> tuple[int, float, int]:
+    def field_line(i: int, label: str) -> str:
+        if i >= len(lines) or not lines[i].strip().startswith(label):
+            raise BvhError(path, min(i + 1, max(len(lines), 1)), f"expected '{label}'")
+        return lines[i].strip()[len(label) :].strip()
+
+    frames_s = field_line(motion_at + 1, "Frames:")
+    if not frames_s.isdigit():
+        raise BvhError(path, motion_at + 2, f"frame count must be a whole number, got {frames_s!r}")
+    ft_s = field_line(motion_at + 2, "Frame Time:")
+    try:
+        frame_time = float(ft_s)
+    except ValueError:
+        raise BvhError(path, motion_at + 3, f"frame time must be a number, got {ft_s!r}") from None
+    if not frame_time > 0:
+        raise BvhError(path, motion_at + 3, f"frame time must be > 0, got {frame_time}")
+    return int(frames_s), frame_time, motion_at + 3
+
+
+def _channels_to_arrays(joints: list[BvhJoint], data: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n_frames = data.shape[0]
+    rotations = quat.identity((n_frames, len(joints)))
+    positions = np.empty((n_frames, len(joints), 3), dtype=np.float64)
+    col = 0
+    for j, joint in enumerate(joints):
+        positions[:, j] = joint.offset
+        rot_cols: list[int] = []
+        for ch in joint.channels:
+            if ch in _POS:
+                positions[:, j, _POS[ch]] = data[:, col]
+            else:
+                rot_cols.append(col)
+            col += 1
+        if rot_cols:
+            rotations[:, j] = quat.from_euler(np.radians(data[:, rot_cols]), joint.rotation_order)
+    return rotations, positions
+
+
+def read_bvh(path: str | Path) -> Bvh:
+    """Read a BVH file; raises :class:`BvhError` naming the file and line."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFileError(p, f"cannot read BVH: {exc}") from exc
+    return parse_bvh(text, str(p))
+
+
+def _children(bvh: Bvh) -> dict[int, list[int]]:
+    children: dict[int, list[int]] = {}
+    for i, j in enumerate(bvh.joints):
+        children.setdefault(j.parent, []).append(i)
+    return children
+
+
+def _dfs_order(bvh: Bvh) -> list[int]:
+    """Joint indices in the order the hierarchy is written (and frame columns follow)."""
+    children = _children(bvh)
+    out: list[int] = []
+    stack = list(reversed(children.get(-1, [])))
+    while stack:
+        i = stack.pop()
+        out.append(i)
+        stack.extend(reversed(children.get(i, [])))
+    return out
+
+
+def _hierarchy_lines(bvh: Bvh) -> Iterator[str]:
+    children = _children(bvh)
+
+    def emit(i: int, depth: int) -> Iterator[str]:
+        j = bvh.joints[i]
+        pad = "  " * depth
+        yield f"{pad}{'ROOT' if j.parent < 0 else 'JOINT'} {j.name}"
+        yield f"{pad}{{"
+        yield f"{pad}  OFFSET {_fmt(j.offset)}"
+        yield f"{pad}  CHANNELS {len(j.channels)} {' '.join(j.channels)}".rstrip()
+        for c in children.get(i, []):
+            yield from emit(c, depth + 1)
+        if j.end_site is not None:
+            yield f"{pad}  End Site"
+            yield f"{pad}  {{"
+            yield f"{pad}    OFFSET {_fmt(j.end_site)}"
+            yield f"{pad}  }}"
+        yield f"{pad}}}"
+
+    yield "HIERARCHY"
+    for root in children.get(-1, []):
+        yield from emit(root, 0)
+
+
+def _fmt(v: tuple[float, ...] | np.ndarray) -> str:
+    return " ".join(f"{float(x):.6f}" for x in v)
+
+
+def format_bvh(bvh: Bvh, decimals: int = 4) -> str:
+    """BVH text for ``bvh`` (rotations written as Euler degrees in each joint's channel order)."""
+    cols: list[np.ndarray] = []
+    for j in _dfs_order(bvh):
+        joint = bvh.joints[j]
+        euler = None
+        if joint.rotation_order:
+            euler = np.degrees(quat.to_euler(bvh.rotations[:, j], joint.rotation_order))
+        r = 0
+        for ch in joint.channels:
+            if ch in _POS:
+                cols.append(bvh.positions[:, j, _POS[ch]])
+            else:
+                assert euler is not None
+                cols.append(euler[:, r])
+                r += 1
+    data = np.stack(cols, axis=-1) if cols else np.zeros((bvh.n_frames, 0))
+    data = np.where(np.abs(data) < 0.5 * 10.0**-decimals, 0.0, data)  # no "-0.0000"
+    out = list(_hierarchy_lines(bvh))
+    out.append("MOTION")
+    out.append(f"Frames: {bvh.n_frames}")
+    out.append(f"Frame Time: {bvh.frame_time_s:.8f}")
+    fmt = f"{{:.{decimals}f}}"
+    for row in data:
+        out.append(" ".join(fmt.format(x) for x in row))
+    return "\n".join(out) + "\n"
+
+
+def write_bvh(bvh: Bvh, path: str | Path, decimals: int = 4) -> None:
+    """Write ``bvh`` to ``path`` (see :func:`format_bvh`)."""
+    Path(path).write_text(format_bvh(bvh, decimals), encoding="utf-8")

@@ -1,0 +1,59 @@
+"""Export a performance as BVH: both players' skeletons sampled at a fixed rate.
+
+``performance_to_bvh(animator, t0, t1, fps, path)`` writes one BVH per figure
+(``<stem>_drums.bvh`` and ``<stem>_bass.bvh``; a BVH holds a single root),
+frames at ``t0 + i / fps`` exactly, joints named as in
+:data:`virja.motion.skeleton.SKELETON`, metres, y up, Euler ZXY degrees.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from virja.motion.band import FIGURES, BandAnimator
+from virja.motion.bvh import Bvh, BvhJoint, write_bvh
+from virja.motion.skeleton import SKELETON
+
+
+def skeleton_joints() -> list[BvhJoint]:
+    """BVH joints of the project skeleton (the root with position channels)."""
+    out = []
+    for i, name in enumerate(SKELETON.names):
+        ch: tuple[str, ...] = ("Zrotation", "Xrotation", "Yrotation")
+        if i == 0:
+            ch = ("Xposition", "Yposition", "Zposition", *ch)
+        off = SKELETON.offsets[i]
+        out.append(
+            BvhJoint(
+                name, int(SKELETON.parents[i]), (float(off[0]), float(off[1]), float(off[2])), ch
+            )
+        )
+    return out
+
+
+def performance_to_bvh(
+    animator: BandAnimator, t0: float, t1: float, fps: float, path: str | Path
+) -> list[Path]:
+    """Sample [t0, t1] at ``fps`` and write ``<stem>_drums.bvh`` and ``<stem>_bass.bvh``.
+
+    Returns the paths written.  ``path`` may end in ``.bvh`` or not.
+    """
+    if not fps > 0:
+        raise ValueError(f"fps must be > 0, got {fps}")
+    if t1 < t0:
+        raise ValueError(f"end {t1} before start {t0}")
+    n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
+    loc = np.stack([animator.local_rotations(t0 + i / fps) for i in range(n)])  # (n, 2, j, 4)
+    p = Path(path)
+    stem = p.with_suffix("") if p.suffix.lower() == ".bvh" else p
+    joints = skeleton_joints()
+    written = []
+    for fi, fig in enumerate(FIGURES):
+        pos = np.broadcast_to(SKELETON.offsets, (n, SKELETON.n_joints, 3)).copy()
+        pos[:, 0] = animator.idle[fig].root_positions[0]
+        out = stem.parent / f"{stem.name}_{fig}.bvh"
+        write_bvh(Bvh(joints, 1.0 / fps, loc[:, fi], pos), out)
+        written.append(out)
+    return written

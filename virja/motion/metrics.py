@@ -1,0 +1,170 @@
+"""Quality of the animation, measured: impact timing, contact, continuity.
+
+- **Contact error** (m): at each planned impact, the distance from the
+  contact point to the instrument in :mod:`virja.geometry`: stick tip to the
+  struck head or cymbal surface, toe to the pressed pedal, fretting fingertip
+  to the stopped string point, plucking fingertip to the pluck point.
+- **Timing error** (s): when the contact point is actually closest to its
+  target (strokes: closest approach within +-60 ms of the impact, 1 ms
+  steps; the bass's left hand: first time within 2 mm) minus the planned
+  impact.
+- **Continuity** (rad/s per frame): the largest change of any limb joint's
+  angular velocity between consecutive frames, split into frames inside a
+  connection interval (two instances blending) and frames within one clip.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from virja.geometry import Geometry
+from virja.motion import quat
+from virja.motion.band import FIGURE_LIMBS, FIGURES, BandAnimator, PlannedNoteLike, sticks
+from virja.motion.skeleton import LIMB_JOINTS, SKELETON
+
+_SK = SKELETON
+CONTACT_TOLERANCE_M = 0.01
+
+
+@dataclass(frozen=True)
+class NoteCheck:
+    """One planned note's measurements (``fret_contact_m`` None for open strings and drums)."""
+
+    motion: str
+    impact: float
+    contact_m: float
+    timing_s: float
+    fret_contact_m: float | None = None
+
+
+@dataclass
+class MotionReport:
+    """Summary of :func:`measure` (lengths in metres, times in seconds)."""
+
+    notes: list[NoteCheck] = field(default_factory=list)
+    continuity_connection: float = 0.0
+    continuity_within: float = 0.0
+    frames: int = 0
+
+    @property
+    def max_contact_m(self) -> float:
+        vals = [n.contact_m for n in self.notes] + [
+            n.fret_contact_m for n in self.notes if n.fret_contact_m is not None
+        ]
+        return max(vals, default=0.0)
+
+    @property
+    def mean_contact_m(self) -> float:
+        return float(np.mean([n.contact_m for n in self.notes])) if self.notes else 0.0
+
+    @property
+    def max_timing_s(self) -> float:
+        return max((abs(n.timing_s) for n in self.notes), default=0.0)
+
+    @property
+    def mean_timing_s(self) -> float:
+        return float(np.mean([abs(n.timing_s) for n in self.notes])) if self.notes else 0.0
+
+    @property
+    def contacts_over_tolerance(self) -> int:
+        return sum(
+            1
+            for n in self.notes
+            if n.contact_m > CONTACT_TOLERANCE_M or (n.fret_contact_m or 0.0) > CONTACT_TOLERANCE_M
+        )
+
+
+def contact_distance(
+    animator: BandAnimator, p: PlannedNoteLike, t: float
+) -> tuple[float, float | None]:
+    """(contact distance, fretting distance or None) of note ``p`` at time ``t`` (m)."""
+    geo: Geometry = animator.geometry
+    loc = animator.local_rotations(t)
+    wpos, wrot = _SK.fk(loc, animator._roots)
+    if p.performer == "drums":
+        piece = p.piece or animator.library[p.motion].piece or ""
+        if p.limb in ("left_hand", "right_hand"):
+            tip = sticks(wpos[0], wrot[0])[0 if p.limb == "left_hand" else 1, 1]
+            return geo.kit.surface_distance(piece, tip), None
+        pedal = geo.kit.kick_pedal if piece == "kick" else geo.kit.hihat_pedal
+        toe = wpos[0, _SK.index("RightToe" if p.limb == "right_foot" else "LeftToe")]
+        return float(np.linalg.norm(toe - pedal.toe_point(True))), None
+    assert p.string is not None
+    pluck = float(
+        np.linalg.norm(wpos[1, _SK.index("RightHandEnd")] - geo.bass.pluck_point(p.string))
+    )
+    fret = None
+    if p.fret:
+        fret = float(
+            np.linalg.norm(
+                wpos[1, _SK.index("LeftHandEnd")] - geo.bass.string_point(p.string, p.fret)
+            )
+        )
+    return pluck, fret
+
+
+def _timing(animator: BandAnimator, p: PlannedNoteLike) -> float:
+    ts = p.impact + np.arange(-60, 61) * 1e-3
+    d = np.array([contact_distance(animator, p, float(t))[0] for t in ts])
+    return float(ts[int(np.argmin(d))] - p.impact)
+
+
+def in_connection(
+    animator: BandAnimator, t: float, figure: str | None = None, limb: str | None = None
+) -> bool:
+    """Whether a limb (or the given figure/limb) is blending two instances (or fading from rest) at ``t``."""
+    for (fig, lb), tl in animator.timelines.items():
+        if (figure is not None and fig != figure) or (limb is not None and lb != limb):
+            continue
+        for inst in tl.active(t):
+            if 0.0 < inst.weight(t) < 1.0:
+                return True
+    return False
+
+
+def continuity(
+    animator: BandAnimator, t0: float, t1: float, fps: float = 120.0
+) -> tuple[float, float, int]:
+    """(largest angular-velocity jump in connections, within clips, frames) over [t0, t1]."""
+    times = t0 + np.arange(int((t1 - t0) * fps) + 1) / fps
+    if len(times) < 3:
+        return 0.0, 0.0, len(times)
+    loc = np.stack([animator.local_rotations(float(t)) for t in times])  # (k, 2, n, 4)
+    limb_idx = sorted(
+        {_SK.index(j) for f in FIGURES for limb in FIGURE_LIMBS[f] for j in LIMB_JOINTS[limb]}
+    )
+    q = loc[:, :, limb_idx]
+    rel = quat.multiply(quat.conjugate(q[:-1]), q[1:])
+    axis, ang = quat.to_axis_angle(rel)
+    omega = axis * ang[..., None] * fps  # (k-1, 2, j, 3) rad/s
+    jump = np.linalg.norm(omega[1:] - omega[:-1], axis=-1).max(axis=(1, 2))  # (k-2,)
+    conn = np.array([in_connection(animator, float(t)) for t in times[1:-1]])
+    c = float(jump[conn].max()) if conn.any() else 0.0
+    w = float(jump[~conn].max()) if (~conn).any() else 0.0
+    return c, w, len(times)
+
+
+def measure(
+    animator: BandAnimator,
+    planned: Sequence[PlannedNoteLike],
+    *,
+    fps: float = 120.0,
+    timing: bool = True,
+) -> MotionReport:
+    """Contact, timing and continuity of ``planned`` (already added to ``animator``)."""
+    rep = MotionReport()
+    for p in planned:
+        c, f = contact_distance(animator, p, p.impact)
+        rep.notes.append(
+            NoteCheck(p.motion, p.impact, c, _timing(animator, p) if timing else 0.0, f)
+        )
+    if planned:
+        t0 = min(p.start for p in planned)
+        t1 = max(p.impact for p in planned) + 0.6
+        rep.continuity_connection, rep.continuity_within, rep.frames = continuity(
+            animator, t0, t1, fps
+        )
+    return rep

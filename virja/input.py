@@ -8,7 +8,6 @@ tempo, the events to sound in the audio track, and a report for the CLI.
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -71,24 +70,18 @@ def input_kind(path: Path) -> str:
     raise InputFileError(path, "neither a MIDI file nor a pcap recording (by name or content)")
 
 
-def _routing(args: argparse.Namespace) -> RoutingConfig:
-    from virja.cli.common import routing_config
-
-    return routing_config(args)
-
-
 def load_performance_input(
-    path: Path, args: argparse.Namespace, *, lookahead_beats: float = 1.0
+    path: Path,
+    routing: RoutingConfig,
+    *,
+    lookahead_beats: float = 1.0,
+    port: int | None = None,
+    key_file: str | None = None,
 ) -> PerformanceInput:
-    kind = input_kind(path)
-    if kind == "midi":
-        return midi_input(path, _routing(args), lookahead_beats)
-    return pcap_input(
-        path,
-        _routing(args),
-        port=getattr(args, "port", None),
-        key_file=getattr(args, "key_file", None),
-    )
+    """A MIDI file or a pcap recording (by name, else by content) as a reveal schedule."""
+    if input_kind(path) == "midi":
+        return midi_input(path, routing, lookahead_beats)
+    return pcap_input(path, routing, port=port, key_file=key_file)
 
 
 def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> PerformanceInput:

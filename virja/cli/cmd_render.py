@@ -19,7 +19,13 @@ import argparse
 import sys
 from pathlib import Path
 
-from virja.cli.common import ProgressBar, add_routing_arguments, make_router, open_plan_log
+from virja.cli.common import (
+    ProgressBar,
+    add_routing_arguments,
+    make_router,
+    open_plan_log,
+    routing_config,
+)
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
 
@@ -95,7 +101,9 @@ def run(args: argparse.Namespace) -> int:
     out = OutputSpec.from_path(args.out)
     if args.at is not None and out.kind != "png":
         raise ConfigError("--at renders one frame: give --out NAME.png")
-    src = load_performance_input(Path(args.input), args, lookahead_beats=args.lookahead_beats)
+    src = load_performance_input(
+        Path(args.input), routing_config(args), lookahead_beats=args.lookahead_beats
+    )
     for line in src.report:
         print(line)
     if src.note_count == 0:

@@ -305,7 +305,7 @@ def run_all(
     figs.append(Figure("pose_ms", pose_ms(int(600 * scale)), "ms/frame", 1.0, False))
     say("render")
     fps, gl_name = render_fps(3.0 * scale)
-    figs.append(Figure("render_fps", fps, "frames/s", 60.0, True, "1280x720, 4x MSAA, no readback"))
+    figs.append(Figure("render_fps", fps, "frames/s", 60.0, True, "1280x720, no MSAA, no readback"))
     say("render with readback")
     fps_rb, _ = render_fps(3.0 * scale, readback=True)
     figs.append(
@@ -315,7 +315,7 @@ def run_all(
             "frames/s",
             30.0,
             True,
-            "1280x720, as for video at 30 fps",
+            "1280x720, no MSAA, with readback as for video",
         )
     )
     info = machine() | {"gl_renderer": gl_name}

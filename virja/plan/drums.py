@@ -203,10 +203,18 @@ def solve(
                         tl = t
                 if not ok:
                     continue
+                # _canonical, inlined (this loop is the scheduler's hot spot)
                 if played:
-                    new = _canonical((row, t, tr, tl), t, timing, max_interval)
+                    np_, npt = row, t
+                elif prev_t is not None and t - prev_t >= rest_s:
+                    np_, npt = None, None
                 else:
-                    new = _canonical((prev, prev_t, tr, tl), t, timing, max_interval)
+                    np_, npt = prev, prev_t
+                if tr is not None and t - tr >= max_interval:
+                    tr = None
+                if tl is not None and t - tl >= max_interval:
+                    tl = None
+                new = (np_, npt, tr, tl)
                 old = nxt.get(new)
                 if old is None or total < old:
                     nxt[new] = total

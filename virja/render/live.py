@@ -29,6 +29,7 @@ class LiveView:
         self.host = WindowHost(size, title)
         self.samples = samples
         self.target: OffscreenTarget | None = None
+        self.lead_s = 0.0  # running estimate of one frame's drawing time
         self.renderer = Renderer(self.host.ctx)
         self.static: DrawList = static_scene()
         self.host.on_screenshot = self._save_screenshot
@@ -49,15 +50,24 @@ class LiveView:
         return self.host.should_close
 
     def frame(self, perf: Performance, time_s: float) -> None:
-        """Draw the band at ``time_s`` offscreen, copy it to the window, show it."""
+        """Draw the band offscreen, copy it to the window, show it.
+
+        The pose drawn is the one at ``time_s`` plus the time a frame takes to draw
+        (a running estimate): the picture shows the moment at which it appears,
+        so an impact is on screen when its sound is due, not a frame later.
+        """
+        started = time.perf_counter()
         fb = self.host.framebuffer()
         if self.target is None or self.target.size != fb.size:
             if self.target is not None:
                 self.target.release()
             self.target = OffscreenTarget(self.host.ctx, fb.size, samples=self.samples)
-        pose = perf.pose(time_s)
+        pose = perf.pose(time_s + self.lead_s)
         self.renderer.draw([self.static, band_scene(pose)], self.host.state.camera, self.target.fbo)
         self.host.ctx.copy_framebuffer(fb, self.target.fbo)
+        self.host.ctx.finish()
+        cost = time.perf_counter() - started
+        self.lead_s = min(0.1, 0.8 * self.lead_s + 0.2 * cost)
         self._fps_frames += 1
         now = time.perf_counter()
         if now - self._fps_since >= 1.0:

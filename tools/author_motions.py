@@ -116,7 +116,12 @@ def drummer_body(geo: Geometry) -> Body:
     return Body(o + np.array([0.0, 0.60, 0.0]), torso)
 
 
-STICK_PITCH_RAD = 0.42  # sticks slope down 24 deg toward what they strike
+STICK_PITCH_RAD = 0.30  # sticks slope down 17 deg toward what they strike
+# Sticks converge in a V (matched grip): each stick points along the line from a
+# point 12 cm outside and 10 cm ahead of its shoulder to the tip, so on the snare
+# the two sticks meet at ~75 deg and the hands sit outside the tips, well ahead of
+# the belly, instead of straight behind the tips against the body.
+STICK_ANCHOR = np.array([0.12, 0.0, 0.10])
 READY_RISE_M = 0.07  # at rest the stick tips hover 7 cm over the snare
 
 
@@ -124,15 +129,16 @@ def stick_hand(body: Body, side: str, tip: np.ndarray, rise: float = 0.0) -> boo
     """Pose the ``side`` arm so its stick tip is exactly at ``tip``.
 
     The stick points from above and behind: horizontally along the line from
-    the shoulder to the tip, pitched down STICK_PITCH_RAD, so the sticks slope
-    down onto the heads and converge toward the middle of the kit.  ``rise``
+    a point outside and ahead of the shoulder (STICK_ANCHOR) to the tip, pitched
+    down STICK_PITCH_RAD, so the sticks slope down onto the heads and converge
+    toward the middle of the kit.  ``rise``
     (m) is how far the tip is lifted above its stroke's strike point: the wrist
     takes most of the lift (the stick tilts up), as drummers do.
     """
     pitch = float(np.arcsin(np.clip(np.sin(STICK_PITCH_RAD) - 0.8 * rise / STICK_TIP_M, -0.6, 0.9)))
     s = 1.0 if side == "Left" else -1.0
     shoulder = body.pos(f"{side}Arm")
-    flat = tip - shoulder
+    flat = tip - (shoulder + STICK_ANCHOR * np.array([s, 1.0, 1.0]))
     flat[1] = 0.0
     flat = _unit(flat)
     d = np.cos(pitch) * flat - np.sin(pitch) * UP
@@ -201,6 +207,25 @@ def keyed_path(keys: list[tuple[float, np.ndarray, str]]) -> Path3:
 
 
 def hand_stroke(geo: Geometry, piece: str, side: str) -> tuple[np.ndarray, np.ndarray, float]:
+    """A stroke on ``piece``; a piece across the kit that the arm cannot reach at
+    its usual spot (the left hand on the ride) is struck nearer its edge."""
+    fraction = geo.kit.strike_in[piece]
+    while True:
+        try:
+            return _hand_stroke(geo, piece, side, fraction)
+        except OutOfReach:
+            if fraction >= 0.9:
+                raise
+            fraction = min(0.9, fraction + 0.1)
+
+
+class OutOfReach(SystemExit):
+    """A key point of a stroke is beyond the arm's reach."""
+
+
+def _hand_stroke(
+    geo: Geometry, piece: str, side: str, fraction: float
+) -> tuple[np.ndarray, np.ndarray, float]:
     base = drummer_body(geo)
     drummer_ready(base, geo)
     limb = f"{side.lower()}_hand"
@@ -209,7 +234,7 @@ def hand_stroke(geo: Geometry, piece: str, side: str) -> tuple[np.ndarray, np.nd
         + quat.rotate(base.wrot[SK.index(f"{side}Hand")], STICK_AXIS_LOCAL) * STICK_TIP_M
     )
     p = geo.kit.pieces[piece]
-    strike = geo.kit.strike_point(piece)
+    strike = geo.kit.strike_point(piece, base.pos(f"{side}Arm"), fraction)
     travel = float(np.linalg.norm(strike - ready))
     # seconds from the ready pose to impact: farther pieces take longer; on a frame
     prep = _on_frame(0.22 + 0.35 * travel)
@@ -235,7 +260,7 @@ def hand_stroke(geo: Geometry, piece: str, side: str) -> tuple[np.ndarray, np.nd
     for t in frames:
         b = base.copy()
         if not stick_hand(b, side, path(t), float(rise_path(t)[0])):
-            raise SystemExit(f"{piece} {limb}: stick tip out of reach at t={t:.3f}")
+            raise OutOfReach(f"{piece} {limb}: stick tip out of reach at t={t:.3f}")
         out.append(b.local.copy())
     return np.array(out), base.root, prep
 
@@ -285,7 +310,7 @@ def _frames(duration: float) -> np.ndarray:
 def bassist_body(geo: Geometry) -> Body:
     o = geo.stage.bassist_origin
     torso = {
-        "Spine": quat.from_axis_angle([0, 1, 0], 0.30),  # turned 17 deg toward the bass (his left)
+        "Spine": quat.from_axis_angle([0, 1, 0], 0.40),  # turned 23 deg toward the bass (his left)
         "Chest": quat.from_axis_angle([1, 0, 0], 0.08),
     }
     return Body(o + np.array([0.0, 0.96, -0.05]), torso)

@@ -95,20 +95,27 @@ class DrumKit:
     # how far in from the rim strokes land, as a fraction of the radius (toward the drummer)
     strike_in: MappingProxyType[str, float]
 
-    def strike_point(self, piece: str) -> Vec:
+    def strike_point(
+        self, piece: str, toward: Vec | None = None, fraction: float | None = None
+    ) -> Vec:
         """Where a stick tip lands on ``piece`` (on the head / top face), (3,) metres.
 
-        Strokes land between the centre and the rim on the side nearest the
-        throne (cymbals: out toward the edge, where they are played).
+        Strokes land between the centre and the rim on the side nearest
+        ``toward`` (default the throne; the authoring tool passes the striking
+        hand's shoulder, so each hand plays the side of a head nearest itself);
+        cymbals out toward the edge, where they are played.  ``fraction`` of
+        the radius from the centre overrides the piece's ``strike_in``.
         """
         p = self.pieces[piece]
-        toward = self.throne_centre - p.centre
-        toward = toward - np.dot(toward, p.normal) * p.normal
-        n = np.linalg.norm(toward)
-        if n < 1e-9:
-            return p.centre.copy()
+        ref = self.throne_centre if toward is None else np.asarray(toward, dtype=np.float64)
+        toward_v = ref - p.centre
+        toward_v = toward_v - np.dot(toward_v, p.normal) * p.normal
+        n = np.linalg.norm(toward_v)
         top = p.centre + (p.thickness / 2 if isinstance(p, Cymbal) else 0.0) * p.normal
-        return top + self.strike_in[piece] * p.radius * toward / n
+        if n < 1e-9:
+            return top
+        frac = self.strike_in[piece] if fraction is None else fraction
+        return top + frac * p.radius * toward_v / n
 
     def surface_distance(self, piece: str, point: Vec) -> float:
         """Distance (m) from ``point`` to the struck surface of ``piece`` (head disc or cymbal top)."""
@@ -143,7 +150,7 @@ class UprightBass:
     neck_length: float
     max_fret: int = 20
     pluck_from_bridge_m: float = (
-        0.30  # where the right hand plucks: near the end of the fingerboard
+        0.34  # where the right hand plucks: near the end of the fingerboard
     )
 
     @property
@@ -201,27 +208,35 @@ def _make_kit(o: Vec) -> DrumKit:
         r = np.radians(deg)
         return _unit(_v(toward_x, np.cos(r), -np.sin(r)))
 
+    # A realistic layout for a seated drummer whose hip joints are at ``o``
+    # (throne top 0.52 m): the hands work 35-45 cm in front of the shoulders,
+    # so the elbows bend 60-100 deg, not the 110-170 deg of a kit crowded
+    # against the body.
     pieces: dict[str, Drum | Cymbal] = {
-        # 22" bass drum standing on the floor, batter head facing the drummer (-z)
-        "kick": Drum("kick", o + _v(-0.10, 0.28, 0.62), _v(0, 0, -1), 0.279, 0.40),
-        # 14" snare between the knees, a little to the left, tipped 8 deg toward the drummer
-        "snare": Drum("snare", o + _v(0.10, 0.66, 0.46), tilt(8), 0.178, 0.14),
-        # 10" and 12" rack toms over the kick, tipped 25 deg
-        "tom_high": Drum("tom_high", o + _v(0.10, 0.86, 0.66), tilt(25, -0.05), 0.127, 0.20),
-        "tom_low": Drum("tom_low", o + _v(-0.22, 0.86, 0.66), tilt(25, 0.05), 0.152, 0.22),
-        # 16" floor tom at the right knee, flat
-        "tom_floor": Drum("tom_floor", o + _v(-0.42, 0.62, 0.38), _v(0, 1, 0), 0.203, 0.40),
-        # 14" hi-hat on the left, flat (top cymbal when closed)
-        "hihat": Cymbal("hihat", o + _v(0.46, 0.86, 0.50), _v(0, 1, 0), 0.178),
-        # 20" ride on the right, 16" crash on the left, both tipped toward the drummer
-        "ride": Cymbal("ride", o + _v(-0.55, 1.00, 0.55), tilt(12, 0.1), 0.254),
-        "crash": Cymbal("crash", o + _v(0.40, 1.18, 0.66), tilt(15, -0.1), 0.203),
+        # 22" bass drum on the floor in front of the right leg, batter head facing
+        # the drummer (-z), just past the end of the kick pedal's board
+        "kick": Drum("kick", o + _v(-0.10, 0.28, 0.70), _v(0, 0, -1), 0.279, 0.40),
+        # 14" snare between the knees, a little to the left, its near rim ~22 cm in
+        # front of the belly; head a hand above the thighs, tipped 8 deg toward him
+        "snare": Drum("snare", o + _v(0.10, 0.68, 0.52), tilt(8), 0.178, 0.14),
+        # 10" and 12" rack toms over the kick, tipped 25 deg toward the drummer
+        "tom_high": Drum("tom_high", o + _v(0.06, 0.88, 0.76), tilt(25, -0.05), 0.127, 0.20),
+        "tom_low": Drum("tom_low", o + _v(-0.26, 0.88, 0.76), tilt(25, 0.05), 0.152, 0.22),
+        # 16" floor tom beside the right knee, flat, level with the snare
+        "tom_floor": Drum("tom_floor", o + _v(-0.50, 0.64, 0.46), _v(0, 1, 0), 0.203, 0.40),
+        # 14" hi-hat on the left, past the snare, flat (top cymbal when closed)
+        "hihat": Cymbal("hihat", o + _v(0.48, 0.90, 0.56), _v(0, 1, 0), 0.178),
+        # 20" ride on the right and forward of the floor tom, 16" crash front left,
+        # both tipped toward the drummer
+        "ride": Cymbal("ride", o + _v(-0.60, 1.02, 0.72), tilt(12, 0.1), 0.254),
+        "crash": Cymbal("crash", o + _v(0.40, 1.20, 0.80), tilt(15, -0.1), 0.203),
     }
+    # pedals a shin's length ahead of the knees' plumb line, so the shins slope forward
     kick_pedal = Pedal(
-        "kick", o + _v(-0.12, 0.02, 0.08), _unit(_v(0, 0.30, 1)), _unit(_v(0, 0.12, 1)), 0.26
+        "kick", o + _v(-0.12, 0.02, 0.30), _unit(_v(0, 0.30, 1)), _unit(_v(0, 0.12, 1)), 0.26
     )
     hihat_pedal = Pedal(
-        "hihat", o + _v(0.30, 0.02, 0.12), _unit(_v(0, 0.30, 1)), _unit(_v(0, 0.12, 1)), 0.28
+        "hihat", o + _v(0.30, 0.02, 0.30), _unit(_v(0, 0.30, 1)), _unit(_v(0, 0.12, 1)), 0.28
     )
     strike_in = {
         "kick": 0.0,  # the beater hits the centre
@@ -244,15 +259,20 @@ def _make_kit(o: Vec) -> DrumKit:
 
 
 def _make_bass(o: Vec) -> UprightBass:
-    # The bass stands on its endpin in front of the player, a little to his left,
-    # leaning back toward him 14 deg; its strings face the audience (+z).
-    endpin = o + _v(0.14, 0.0, 0.30)
-    lean = np.radians(14.0)
-    axis = _unit(_v(-0.05, np.cos(lean), -np.sin(lean)))
-    front = _unit(np.cross(np.cross(axis, _v(0, 0, 1)), axis))  # +z made perpendicular to axis
+    # The player (hip joints over ``o``, facing +z) stands behind and to the right
+    # of the bass: it stands on its endpin in front of him, a little to his left,
+    # leaning back so the upper bout rests against his belly and the neck passes
+    # his head on the left, the nut at eye height (1.66 m) 26 cm left of his nose;
+    # the strings face forward and 28 deg to his right, toward his plucking hand.
+    endpin = o + _v(0.0, 0.0, 0.40)
+    nut_target = o + _v(0.22, 1.66, 0.04)
+    axis = _unit(nut_target - endpin)
+    yaw = np.radians(28.0)
+    facing = _v(-np.sin(yaw), 0.0, np.cos(yaw))  # forward, turned to the player's right (-x)
+    front = _unit(facing - np.dot(facing, axis) * axis)  # made perpendicular to the axis
     lateral = _unit(np.cross(axis, front))  # toward the player's left (+x) roughly
     scale = 1.05  # 3/4 bass, 41.3 inch string length
-    nut_centre = endpin + 1.72 * axis + 0.035 * front
+    nut_centre = endpin + float(np.linalg.norm(nut_target - endpin)) * axis + 0.035 * front
     bridge_centre = nut_centre + scale * _unit(-axis + 0.045 * front)
     nut_half_spacing = (-0.015, -0.005, 0.005, 0.015)  # E A D G across the nut (m)
     bridge_half_spacing = (-0.045, -0.015, 0.015, 0.045)
@@ -273,7 +293,8 @@ def _make_bass(o: Vec) -> UprightBass:
         scale_m=scale,
         nut=MappingProxyType(nut),
         bridge=MappingProxyType(bridge),
-        body_centre=endpin + 0.55 * axis - 0.08 * front,
+        # the body starts 6 cm above the endpin's tip; the bridge stands near its waist
+        body_centre=endpin + 0.62 * axis - 0.08 * front,
         body_height=1.10,
         body_width=0.62,
         body_depth=0.22,

@@ -64,8 +64,11 @@ class Camera:
 
 PRESETS: dict[str, Camera] = {
     "front": Camera(),
-    "drums": Camera(target=(-0.75, 0.8, 0.0), yaw_deg=-25.0, pitch_deg=22.0, distance_m=2.8),
-    "bass": Camera(target=(0.9, 1.1, 0.0), yaw_deg=30.0, pitch_deg=8.0, distance_m=2.6),
+    # high enough to see the sticks over the rack toms; centred on the kit, which
+    # stands 0.2-0.8 m in front of the drummer
+    "drums": Camera(target=(-0.8, 0.8, 0.15), yaw_deg=-25.0, pitch_deg=30.0, distance_m=2.8),
+    # from the audience's right, where the bass's strings face past the player
+    "bass": Camera(target=(0.95, 1.05, 0.15), yaw_deg=20.0, pitch_deg=10.0, distance_m=2.5),
     "top": Camera(pitch_deg=70.0, distance_m=6.0),
 }
 

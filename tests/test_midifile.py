@@ -152,3 +152,61 @@ def test_demo_session_reads() -> None:
     s = read_midi(DEMO_MID)
     assert 20 < s.duration_s < 30
     assert {t.name for t in s.tracks} >= {"Walking Bass", "Drums", "Piano"}
+
+
+def test_tempo_zero_is_refused_naming_file_track_and_tick(tmp_path: Path) -> None:
+    """A set_tempo of 0 µs per beat is an InputFileError naming the file, track and tick."""
+    conductor = [Meta("set_tempo", tempo=500_000, time=0), Meta("set_tempo", tempo=0, time=96)]
+    p = save_midi(tmp_path / "t0.mid", [conductor, [M("note_on", note=40, velocity=90)]])
+    with pytest.raises(InputFileError, match=r"t0\.mid: track 0, tick 96: set_tempo of 0"):
+        read_midi(p)
+
+
+def test_time_signature_with_no_beats_per_bar_is_refused(tmp_path: Path) -> None:
+    """A time signature 0/4 (no beats in a bar) is an InputFileError naming the file."""
+    meta = [Meta("time_signature", numerator=0, denominator=4, time=0)]
+    p = save_midi(tmp_path / "ts0.mid", [meta, [M("note_on", note=40, velocity=90)]])
+    with pytest.raises(InputFileError, match=r"ts0\.mid: .*0/4 has no beats per bar"):
+        read_midi(p)
+
+
+def _long_file(tmp_path: Path, beats: int) -> Path:
+    """One note, then its note-off ``beats`` beats later, at 1 tick per beat."""
+    notes = [M("note_on", note=40, velocity=90, time=0), M("note_off", note=40, time=beats)]
+    return save_midi(tmp_path / "long.mid", [notes], tpb=1, type_=0)
+
+
+def test_beats_stop_at_the_cap_with_a_warning_and_notes_stay_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A file longer than MAX_BEATS beats gets MAX_BEATS beats, a warning, and all its notes."""
+    import virja.midifile
+
+    monkeypatch.setattr(virja.midifile, "MAX_BEATS", 50)
+    with caplog.at_level("WARNING", logger="virja.midifile"):
+        s = read_midi(_long_file(tmp_path, 1000))
+    assert len(s.beats) == 50
+    assert [b.time_s for b in s.beats] == pytest.approx([0.5 * i for i in range(50)])
+    assert "only the first 50 beats" in caplog.text and "long.mid" in caplog.text
+    assert s.duration_s == pytest.approx(500.0)
+    assert [type(e) for e in s.events] == [NoteOn, NoteOff]
+
+
+def test_file_ending_exactly_at_the_beat_cap_is_not_warned_about(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Beats at ticks 0..49 of a 49-tick file are all of them: no warning, no beat lost."""
+    import virja.midifile
+
+    monkeypatch.setattr(virja.midifile, "MAX_BEATS", 50)
+    with caplog.at_level("WARNING", logger="virja.midifile"):
+        s = read_midi(_long_file(tmp_path, 49))
+    assert len(s.beats) == 50
+    assert "beats" not in caplog.text
+
+
+def test_beat_cap_is_sane() -> None:
+    """The cap allows a day of music at 120 bpm (172,800 beats) and bounds the rest."""
+    from virja.midifile import MAX_BEATS
+
+    assert 172_800 <= MAX_BEATS <= 1_000_000

@@ -4,11 +4,24 @@ Times are seconds from the start of the file, computed through the file's
 whole tempo map (set_tempo in any track applies to every track, as in type 1
 files), so tempo changes mid-file are honoured.  mido decodes running status;
 a note_on with velocity 0 becomes a :class:`~virja.events.NoteOff`.
+
+Malformed files raise :class:`~virja.errors.InputFileError` naming the file:
+besides what mido refuses, a ``set_tempo`` of 0 µs per beat and a time
+signature with 0 beats per bar.
+
+Beats (:attr:`MidiSession.beats`) are generated from the time signatures up
+to the end of the file, at most :data:`MAX_BEATS` of them (200,000 beats is
+over 27 hours at 120 bpm).  A file whose beats would go past that (a corrupt
+or hostile delta time: one delta of 2^28-1 ticks at 1 tick per beat is 268
+million beats) is still read: its notes and tempo map are whole, its beats
+stop at the cap, and a warning is logged.  This bounds the time and memory
+reading any file takes.
 """
 
 from __future__ import annotations
 
 import bisect
+import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,7 +31,11 @@ from virja.errors import InputFileError
 from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramChange
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, TempoMap
 
+log = logging.getLogger(__name__)
+
 DEFAULT_TEMPO_US = 500_000
+# beats generated per file at most: 27.7 hours at 120 bpm, 2.5 MB of Beat objects' worth
+MAX_BEATS = 200_000
 
 
 @dataclass(frozen=True)
@@ -100,13 +117,23 @@ def read_midi(path: str | Path) -> MidiSession:
         raise InputFileError(p, "SMPTE time division is not supported (ticks per beat needed)")
     tempo_changes: list[tuple[int, int]] = []
     sigs: list[tuple[int, int, int]] = []
-    for track in mf.tracks:
+    for ti, track in enumerate(mf.tracks):
         tick = 0
         for msg in track:
             tick += msg.time
             if msg.type == "set_tempo":
+                if msg.tempo <= 0:
+                    raise InputFileError(
+                        p, f"track {ti}, tick {tick}: set_tempo of {msg.tempo} µs per beat"
+                    )
                 tempo_changes.append((tick, msg.tempo))
             elif msg.type == "time_signature":
+                if msg.numerator <= 0:
+                    raise InputFileError(
+                        p,
+                        f"track {ti}, tick {tick}: time signature "
+                        f"{msg.numerator}/{msg.denominator} has no beats per bar",
+                    )
                 sigs.append((tick, msg.numerator, msg.denominator))
     clock = _TickClock(tempo_changes, mf.ticks_per_beat)
 
@@ -154,7 +181,17 @@ def read_midi(path: str | Path) -> MidiSession:
     duration = clock.to_seconds(end_tick)
     tempo_map = clock.tempo_map()
     sig_s = [(clock.to_seconds(t), n, d) for t, n, d in sorted(sigs)]
-    beats = _beats(clock, sorted(sigs), end_tick, mf.ticks_per_beat)
+    # one beat past the cap tells a file cut short from one that ends at the cap
+    beats = _beats(clock, sorted(sigs), end_tick, mf.ticks_per_beat, MAX_BEATS + 1)
+    if len(beats) > MAX_BEATS:
+        del beats[MAX_BEATS:]
+        log.warning(
+            "%s: only the first %d beats are kept (to %.0f s of %.0f s): the file is too long",
+            p,
+            MAX_BEATS,
+            beats[-1].time_s,
+            duration,
+        )
     return MidiSession(
         path=p,
         events=[e for *_, e in events],
@@ -168,9 +205,14 @@ def read_midi(path: str | Path) -> MidiSession:
 
 
 def _beats(
-    clock: _TickClock, sigs: list[tuple[int, int, int]], end_tick: int, tpb: int
+    clock: _TickClock,
+    sigs: list[tuple[int, int, int]],
+    end_tick: int,
+    tpb: int,
+    max_beats: int = MAX_BEATS,
 ) -> list[Beat]:
-    """Beats from the time signatures (4/4 when none), up to the end of the file."""
+    """Beats from the time signatures (4/4 when none), up to the end of the file
+    or ``max_beats`` beats, whichever comes first."""
     if not sigs or sigs[0][0] != 0:
         sigs = [(0, 4, 4), *sigs]
     out: list[Beat] = []
@@ -181,6 +223,8 @@ def _beats(
         tick = start
         beat_in_bar = 1
         while tick < stop:
+            if len(out) >= max_beats:
+                return out
             t = clock.to_seconds(tick)
             spb = clock.to_seconds(tick + beat_ticks) - t
             level = 2 if beat_in_bar == 1 else (1 if num % 2 == 0 and beat_in_bar % 2 == 1 else 0)
@@ -195,4 +239,4 @@ def _beats(
     return out
 
 
-__all__ = ["MidiSession", "TrackInfo", "read_midi", "DEFAULT_SECONDS_PER_BEAT"]
+__all__ = ["MAX_BEATS", "MidiSession", "TrackInfo", "read_midi", "DEFAULT_SECONDS_PER_BEAT"]

@@ -229,17 +229,7 @@ def time_limit(seconds: float) -> Iterator[None]:
 # (function in virja where the exception escapes, exception type) -> the regression test
 # pinning it in test_regressions.py.  The fuzz tests tolerate exactly these so they keep
 # looking for new bugs while the suite stays green; remove an entry with its fix.
-KNOWN_BUGS: dict[tuple[str, str], str] = {
-    ("_idb", "error"): "test_pcapng_tsoffset_option_cut_short_is_input_file_error",
-    ("_idb", "IndexError"): "test_pcapng_tsresol_option_without_value_is_input_file_error",
-    ("parse_kit", "AttributeError"): "test_drum_kit_priority_not_a_table_is_config_error",
-    ("parse_costs", "AttributeError"): "test_drum_costs_rows_not_a_table_is_config_error",
-    ("parse_timing", "AttributeError"): "test_timing_motion_not_a_table_is_config_error",
-    ("parse_timing", "ZeroDivisionError"): "test_timing_reference_bpm_zero_is_config_error",
-    ("plan_config_from_table", "OverflowError"): "test_plan_bass_frets_inf_is_config_error",
-    ("read_sidecar", "UnicodeDecodeError"): "test_sidecar_not_utf8_is_clip_error",
-    ("_beats", "HangError"): "test_midi_huge_delta_time_does_not_hang",
-}
+KNOWN_BUGS: dict[tuple[str, str], str] = {}
 
 
 def escaping_function(exc: BaseException) -> str:

@@ -52,13 +52,13 @@ Frame Time: 0.0333333
 0.2 0.9 0.0 2.0 0.0 0.0 14.0 0.0 0.0 7.0 0.0 0.0
 """
 
-# Unicode digits that str.isdigit() accepts but int() refuses ("²") and frame counts too
-# large to allocate are left out: both are open bugs pinned by test_regressions.py.
+# "²" (a digit to str.isdigit(), not to int()), "٣" (a digit to float()) and a frame count
+# too large to allocate were bugs (test_regressions.py); they are in the vocabulary now.
 VOCABULARY = (
     "{", "}", "ROOT", "JOINT", "End", "Site", "OFFSET", "CHANNELS", "HIERARCHY", "MOTION",
     "Frames:", "Frame", "Time:", "0", "1", "2", "3", "6", "7", "-1", "0.0", "1e308", "-1e308",
     "nan", "inf", "٣", "x", "Hips", "Spine", "Xrotation", "Yrotation", "Zrotation", "Xposition",
-    "Yposition", "Zposition", "Wrotation",
+    "Yposition", "Zposition", "Wrotation", "²", "100000000000000000", "1_0", "1e999",
 )  # fmt: skip
 
 

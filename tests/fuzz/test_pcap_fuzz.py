@@ -148,11 +148,9 @@ def test_idb_options_cut_short_give_input_file_error_or_capture(
     """Every length of an IDB's options, where the cut falls, reads or is refused cleanly.
 
     (Cuts are 4-aligned: blocks are padded.)  Cut 12 (if_tsresol with no value byte)
-    and 20/24 (if_tsoffset with fewer than 8 value bytes) hit the bugs pinned in test_regressions.py; they are xfail there and
-    skipped here so this sweep guards the other lengths.
+    and 20/24 (if_tsoffset with fewer than 8 value bytes) were bugs (struct.error,
+    IndexError); they are refused now, with the option named.
     """
-    if cut in (12, 20, 24):
-        pytest.skip("known bug, pinned by test_regressions.py")
     p = tmp_path / "idb.pcapng"
     p.write_bytes(idb_options_cut(order, cut))
     assert isinstance(read_or_input_error(p), Capture | InputFileError)

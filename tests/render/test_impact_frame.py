@@ -75,7 +75,9 @@ def test_snare_impact_frame_puts_the_stick_tip_on_the_head(gl_ctx: Any) -> None:
 
 def test_bass_impact_frame_puts_the_finger_on_the_chosen_string_and_fret(gl_ctx: Any) -> None:
     # B-flat after F: the paper's example, played on the A string, fret 1
-    animator, planned = _plan([("bass", NoteOn(1.0, 1, 29, 100)), ("bass", NoteOn(1.5, 1, 34, 100))])
+    animator, planned = _plan(
+        [("bass", NoteOn(1.0, 1, 29, 100)), ("bass", NoteOn(1.5, 1, 34, 100))]
+    )
     p = planned[-1]
     assert (p.string, p.fret) == ("A", 1)
     pose = animator.pose(p.impact)

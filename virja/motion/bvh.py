@@ -17,6 +17,8 @@ and the line.
 
 from __future__ import annotations
 
+import re
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +30,13 @@ from virja.motion import quat
 
 _ROT = {"Xrotation": "X", "Yrotation": "Y", "Zrotation": "Z"}
 _POS = {"Xposition": 0, "Yposition": 1, "Zposition": 2}
+
+# Numbers are ASCII only: str.isdigit() and float() also accept other scripts' digits
+# ("²", "٣") and float() accepts "nan", "inf" and "1_0"; none of them belong in a BVH.
+_COUNT = re.compile(r"[0-9]+\Z")
+_NUM = r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_NUMBER = re.compile(_NUM + r"\Z")
+_FRAME_LINE = re.compile(rf"\s*(?:{_NUM}(?:\s+{_NUM})*)?\s*\Z")
 
 
 class BvhError(InputFileError):
@@ -118,28 +127,37 @@ class _Tokens:
         return line
 
     def number(self, what: str) -> float:
+        """A finite decimal number (ASCII digits; no nan, inf or overflow)."""
         tok, line = self.next(what)
-        try:
-            return float(tok)
-        except ValueError:
-            raise BvhError(self.path, line, f"expected a number for {what}, got {tok!r}") from None
+        value = float(tok) if _NUMBER.match(tok) else float("nan")
+        if not np.isfinite(value):
+            raise BvhError(self.path, line, f"expected a finite number for {what}, got {tok!r}")
+        return value
+
+    def count(self, what: str) -> tuple[int, int]:
+        """A whole number of ASCII digits, and its line."""
+        tok, line = self.next(what)
+        if not _COUNT.match(tok):
+            raise BvhError(self.path, line, f"expected {what} (a whole number), got {tok!r}")
+        return int(tok), line
 
     def peek(self) -> str | None:
         return self._items[self._i][0] if self._i < len(self._items) else None
 
 
-def _parse_joint(tk: _Tokens, name: str, parent: int, joints: list[BvhJoint]) -> None:
+def _joint_header(tk: _Tokens, name: str, parent: int) -> BvhJoint:
+    """``{ OFFSET x y z CHANNELS n ch...`` of one joint (the opening brace included)."""
     tk.expect("{")
     tk.expect("OFFSET")
     offset = (tk.number("OFFSET x"), tk.number("OFFSET y"), tk.number("OFFSET z"))
     tok, line = tk.next("CHANNELS")
     if tok != "CHANNELS":
         raise BvhError(tk.path, line, f"expected 'CHANNELS' in joint {name!r}, got {tok!r}")
-    count_tok, line = tk.next("channel count")
-    if not count_tok.isdigit():
-        raise BvhError(tk.path, line, f"expected a channel count, got {count_tok!r}")
+    count, line = tk.count("a channel count")
+    if count > 6:
+        raise BvhError(tk.path, line, f"joint {name!r} has {count} channels, at most 6 allowed")
     channels: list[str] = []
-    for _ in range(int(count_tok)):
+    for _ in range(count):
         ch, line = tk.next("a channel name")
         if ch not in _ROT and ch not in _POS:
             raise BvhError(tk.path, line, f"unknown channel {ch!r} in joint {name!r}")
@@ -149,15 +167,24 @@ def _parse_joint(tk: _Tokens, name: str, parent: int, joints: list[BvhJoint]) ->
         raise BvhError(
             tk.path, line, f"joint {name!r} needs 0 or 3 rotation channels, has {len(rot)}"
         )
-    index = len(joints)
-    joints.append(BvhJoint(name, parent, offset, tuple(channels)))
-    while True:
+    return BvhJoint(name, parent, offset, tuple(channels))
+
+
+def _parse_joints(tk: _Tokens, root: str) -> list[BvhJoint]:
+    """The joints of one ROOT, depth first, parsed with an explicit stack of open joints
+    (no recursion: a hostile file nesting thousands of JOINTs is parsed, not a
+    RecursionError)."""
+    joints = [_joint_header(tk, root, -1)]
+    open_joints = [0]  # indices of the joints whose '}' has not come yet
+    while open_joints:
+        index = open_joints[-1]
         tok, line = tk.next("'JOINT', 'End' or '}'")
         if tok == "}":
-            return
-        if tok == "JOINT":
+            open_joints.pop()
+        elif tok == "JOINT":
             child, _ = tk.next("a joint name")
-            _parse_joint(tk, child, index, joints)
+            joints.append(_joint_header(tk, child, index))
+            open_joints.append(len(joints) - 1)
         elif tok == "End":
             tk.expect("Site")
             tk.expect("{")
@@ -168,6 +195,7 @@ def _parse_joint(tk: _Tokens, name: str, parent: int, joints: list[BvhJoint]) ->
             joints[index] = BvhJoint(j.name, j.parent, j.offset, j.channels, end)
         else:
             raise BvhError(tk.path, line, f"expected 'JOINT', 'End' or '}}', got {tok!r}")
+    return joints
 
 
 def parse_bvh(text: str, path: str = "<string>") -> Bvh:
@@ -182,37 +210,35 @@ def parse_bvh(text: str, path: str = "<string>") -> Bvh:
     if tok != "ROOT":
         raise BvhError(path, line, f"expected 'ROOT', got {tok!r}")
     name, _ = tk.next("the root's name")
-    joints: list[BvhJoint] = []
-    _parse_joint(tk, name, -1, joints)
+    joints = _parse_joints(tk, name)
     if tk.peek() is not None:
         tok, line = tk.next("end")
         raise BvhError(path, line, f"only one ROOT is supported, got {tok!r} after it")
-    names = [j.name for j in joints]
-    dup = {n for n in names if names.count(n) > 1}
+    dup = {n for n, k in Counter(j.name for j in joints).items() if k > 1}
     if dup:
         raise BvhError(path, 1, f"duplicate joint names {sorted(dup)}")
 
     n_frames, frame_time, first = _motion_header(lines, motion_at, path)
     n_channels = sum(len(j.channels) for j in joints)
+    # count the frame lines before allocating: 'Frames:' is only a claim
+    rows = [i for i in range(first, len(lines)) if not lines[i].isspace() and lines[i]]
+    if len(rows) > n_frames:
+        raise BvhError(path, rows[n_frames] + 1, f"more frame lines than 'Frames: {n_frames}'")
+    if len(rows) < n_frames:
+        raise BvhError(path, len(lines), f"'Frames: {n_frames}' but {len(rows)} frame lines")
     data = np.empty((n_frames, n_channels), dtype=np.float64)
-    row = 0
-    for i in range(first, len(lines)):
+    for row, i in enumerate(rows):
+        if not _FRAME_LINE.match(lines[i]):
+            raise BvhError(path, i + 1, "frame values must be decimal numbers")
         s = lines[i].split()
-        if not s:
-            continue
-        if row >= n_frames:
-            raise BvhError(path, i + 1, f"more frame lines than 'Frames: {n_frames}'")
         if len(s) != n_channels:
             raise BvhError(
                 path, i + 1, f"frame has {len(s)} values, the hierarchy has {n_channels} channels"
             )
-        try:
-            data[row] = [float(x) for x in s]
-        except ValueError:
-            raise BvhError(path, i + 1, "frame values must be numbers") from None
-        row += 1
-    if row != n_frames:
-        raise BvhError(path, len(lines), f"'Frames: {n_frames}' but {row} frame lines")
+        data[row] = [float(x) for x in s]
+    if n_frames and not (finite := np.isfinite(data).all(axis=1)).all():
+        i = rows[int(np.argmin(finite))]
+        raise BvhError(path, i + 1, "frame value out of range (not a finite number)")
     rotations, positions = _channels_to_arrays(joints, data)
     return Bvh(joints, frame_time, rotations, positions, source=path)
 
@@ -224,15 +250,14 @@ def _motion_header(lines: list[str], motion_at: int, path: str) -> tuple[int, fl
         return lines[i].strip()[len(label) :].strip()
 
     frames_s = field_line(motion_at + 1, "Frames:")
-    if not frames_s.isdigit():
+    if not _COUNT.match(frames_s):
         raise BvhError(path, motion_at + 2, f"frame count must be a whole number, got {frames_s!r}")
     ft_s = field_line(motion_at + 2, "Frame Time:")
-    try:
-        frame_time = float(ft_s)
-    except ValueError:
-        raise BvhError(path, motion_at + 3, f"frame time must be a number, got {ft_s!r}") from None
-    if not frame_time > 0:
-        raise BvhError(path, motion_at + 3, f"frame time must be > 0, got {frame_time}")
+    if not _NUMBER.match(ft_s):
+        raise BvhError(path, motion_at + 3, f"frame time must be a number, got {ft_s!r}")
+    frame_time = float(ft_s)
+    if not 0 < frame_time < float("inf"):
+        raise BvhError(path, motion_at + 3, f"frame time must be finite and > 0, got {frame_time}")
     return int(frames_s), frame_time, motion_at + 3
 
 
@@ -273,29 +298,46 @@ def _children(bvh: Bvh) -> dict[int, list[int]]:
 
 
 def _dfs_order(bvh: Bvh) -> list[int]:
-    """Joint indices in the order the hierarchy is written (and frame columns follow)."""
+    """Joint indices in the order the hierarchy is written (and frame columns follow).
+
+    ``bvh.joints`` may be in any order (a child before its parent too); raises
+    ValueError unless there is exactly one root and every joint hangs from it.
+    """
     children = _children(bvh)
+    roots = children.get(-1, [])
+    if len(roots) != 1:
+        raise ValueError(f"a BVH is written with exactly one root joint, got {len(roots)}")
     out: list[int] = []
-    stack = list(reversed(children.get(-1, [])))
+    stack = list(roots)
     while stack:
         i = stack.pop()
         out.append(i)
         stack.extend(reversed(children.get(i, [])))
+    if len(out) != len(bvh.joints):
+        lost = sorted(set(range(len(bvh.joints))) - set(out))
+        names = [bvh.joints[i].name for i in lost[:5]]
+        raise ValueError(f"joints {names} do not hang from the root (bad parent indices)")
     return out
 
 
 def _hierarchy_lines(bvh: Bvh) -> Iterator[str]:
+    """The HIERARCHY section, joints depth first as :func:`_dfs_order` (no recursion)."""
     children = _children(bvh)
-
-    def emit(i: int, depth: int) -> Iterator[str]:
+    yield "HIERARCHY"
+    # (joint, depth, closing): a joint is pushed to open it, then again to close it
+    stack = [(root, 0, False) for root in reversed(children.get(-1, []))]
+    while stack:
+        i, depth, closing = stack.pop()
         j = bvh.joints[i]
         pad = "  " * depth
-        yield f"{pad}{'ROOT' if j.parent < 0 else 'JOINT'} {j.name}"
-        yield f"{pad}{{"
-        yield f"{pad}  OFFSET {_fmt(j.offset)}"
-        yield f"{pad}  CHANNELS {len(j.channels)} {' '.join(j.channels)}".rstrip()
-        for c in children.get(i, []):
-            yield from emit(c, depth + 1)
+        if not closing:
+            yield f"{pad}{'ROOT' if j.parent < 0 else 'JOINT'} {j.name}"
+            yield f"{pad}{{"
+            yield f"{pad}  OFFSET {_fmt(j.offset)}"
+            yield f"{pad}  CHANNELS {len(j.channels)} {' '.join(j.channels)}".rstrip()
+            stack.append((i, depth, True))
+            stack.extend((c, depth + 1, False) for c in reversed(children.get(i, [])))
+            continue
         if j.end_site is not None:
             yield f"{pad}  End Site"
             yield f"{pad}  {{"
@@ -303,17 +345,19 @@ def _hierarchy_lines(bvh: Bvh) -> Iterator[str]:
             yield f"{pad}  }}"
         yield f"{pad}}}"
 
-    yield "HIERARCHY"
-    for root in children.get(-1, []):
-        yield from emit(root, 0)
-
 
 def _fmt(v: tuple[float, ...] | np.ndarray) -> str:
     return " ".join(f"{float(x):.6f}" for x in v)
 
 
 def format_bvh(bvh: Bvh, decimals: int = 4) -> str:
-    """BVH text for ``bvh`` (rotations written as Euler degrees in each joint's channel order)."""
+    """BVH text for ``bvh`` (rotations written as Euler degrees in each joint's channel order).
+
+    The hierarchy is written depth first and the frame columns in that same order,
+    whatever the order of ``bvh.joints``: reading the text back gives the joints
+    depth first, each with its own channels.  Raises ValueError for a joint list
+    that is not one tree (see :func:`_dfs_order`).
+    """
     cols: list[np.ndarray] = []
     for j in _dfs_order(bvh):
         joint = bvh.joints[j]

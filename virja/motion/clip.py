@@ -145,6 +145,10 @@ def read_sidecar(path: Path) -> dict[str, Any]:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ClipError(path, f"cannot read clip sidecar: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise ClipError(
+            path, f"clip sidecar is not UTF-8 text: {exc.reason} at byte {exc.start}"
+        ) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -174,8 +178,8 @@ def read_sidecar(path: Path) -> dict[str, Any]:
                 path, text, "limb", f"limb must be one of {tuple(LIMB_JOINTS)}, got {limb!r}"
             )
     impact = float(need("impact_s", (int, float)))
-    if impact < 0:
-        raise _fail(path, text, "impact_s", f"impact_s must be >= 0, got {impact}")
+    if not 0 <= impact < float("inf"):
+        raise _fail(path, text, "impact_s", f"impact_s must be finite and >= 0, got {impact}")
     joints = need("joints", list)
     if not joints or not all(isinstance(j, str) for j in joints):
         raise _fail(path, text, "joints", "joints must be a non-empty list of joint names")
@@ -188,10 +192,12 @@ def read_sidecar(path: Path) -> dict[str, Any]:
             path, text, "string", f"unknown string {string!r}; expected one of {BASS_STRINGS}"
         )
     fret = data.get("fret")
-    if fret is not None and (not isinstance(fret, int) or not 0 <= fret <= 24):
+    if fret is not None and (
+        not isinstance(fret, int) or isinstance(fret, bool) or not 0 <= fret <= 24
+    ):
         raise _fail(path, text, "fret", f"fret must be a whole number 0-24, got {fret!r}")
     velocity = data.get("velocity", 96)
-    if not isinstance(velocity, int) or not 1 <= velocity <= 127:
+    if not isinstance(velocity, int) or isinstance(velocity, bool) or not 1 <= velocity <= 127:
         raise _fail(path, text, "velocity", f"velocity must be 1-127, got {velocity!r}")
     out = dict(data)
     out.update(

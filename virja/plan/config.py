@@ -14,6 +14,7 @@ relative to the config file).
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,8 +44,68 @@ def _load_toml(path: Path) -> dict[str, Any]:
             return tomllib.load(fh)
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text: {exc.reason}") from exc
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    except ValueError as exc:  # a path with a NUL byte
+        raise ConfigError(f"{path!r}: cannot read: {exc}") from exc
+
+
+# -- typed access: a value of the wrong type anywhere is a ConfigError naming the key ------
+
+
+def _what(value: object) -> str:
+    return f"{type(value).__name__} {value!r}"[:80]
+
+
+def _table(value: object, where: str, key: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: {key} must be a table, got {_what(value)}")
+    return value
+
+
+def _list(value: object, where: str, key: str) -> list[Any]:
+    if not isinstance(value, list):
+        raise ConfigError(f"{where}: {key} must be a list, got {_what(value)}")
+    return value
+
+
+def _str(value: object, where: str, key: str) -> str:
+    if not isinstance(value, str):
+        raise ConfigError(f"{where}: {key} must be a string, got {_what(value)}")
+    return value
+
+
+def _opt_str(value: object, where: str, key: str) -> str | None:
+    return None if value is None else _str(value, where, key)
+
+
+def _int(value: object, where: str, key: str) -> int:
+    """A TOML integer (a bool, a float or a string is refused, not converted)."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ConfigError(f"{where}: {key} must be an integer, got {_what(value)}")
+    return value
+
+
+def _float(value: object, where: str, key: str) -> float:
+    """A finite number (TOML integer or float); NaN, inf, bools and strings are refused."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ConfigError(f"{where}: {key} must be a number, got {_what(value)}")
+    try:
+        out = float(value)
+    except OverflowError:  # an integer beyond float range
+        raise ConfigError(f"{where}: {key} = {value} is out of range") from None
+    if not math.isfinite(out):
+        raise ConfigError(f"{where}: {key} must be finite, got {value!r}")
+    return out
+
+
+def _need(data: dict[str, Any], where: str, key: str, prefix: str = "") -> Any:
+    try:
+        return data[key]
+    except KeyError:
+        raise ConfigError(f"{where}: missing {prefix}{key}") from None
 
 
 @dataclass(frozen=True)
@@ -145,67 +206,124 @@ class PlanConfig:
     timing: Timing
 
 
-def parse_bass(data: dict[str, Any], *, tuning: str | None = None) -> BassSetup:
-    try:
-        tunings = data["tunings"]
-        name = tuning or data["default_tuning"]
-        if name not in tunings:
-            raise ConfigError(f"unknown bass tuning {name!r}; known: {sorted(tunings)}")
-        strings = tuple((str(s["name"]), int(s["open"])) for s in tunings[name]["strings"])
-        return BassSetup(strings, int(data["frets"]), int(data["double_stop_span_frets"]))
-    except (KeyError, TypeError) as exc:
-        raise ConfigError(f"bass table incomplete: missing {exc}") from None
+def parse_bass(
+    data: dict[str, Any], *, tuning: str | None = None, where: str = "bass.toml"
+) -> BassSetup:
+    """The bass of a ``bass.toml`` table, with tuning ``tuning`` (default: its default)."""
+    tunings = _table(_need(data, where, "tunings"), where, "tunings")
+    name = (
+        tuning
+        if tuning is not None
+        else _str(_need(data, where, "default_tuning"), where, "default_tuning")
+    )
+    if name not in tunings:
+        raise ConfigError(f"{where}: unknown bass tuning {name!r}; known: {sorted(tunings)}")
+    chosen = _table(tunings[name], where, f"tunings.{name}")
+    strings = parse_strings(
+        _need(chosen, where, "strings", f"tunings.{name}."), where, f"tunings.{name}.strings"
+    )
+    return BassSetup(
+        strings,
+        _int(_need(data, where, "frets"), where, "frets"),
+        _int(_need(data, where, "double_stop_span_frets"), where, "double_stop_span_frets"),
+    )
 
 
-def parse_kit(data: dict[str, Any]) -> DrumKit:
-    prio = data.get("priority", {})
+def parse_strings(value: object, where: str, key: str) -> tuple[tuple[str, int], ...]:
+    """A list of ``{name, open}`` tables -> ((name, open MIDI note), ...)."""
+    out = []
+    for i, s in enumerate(_list(value, where, key)):
+        entry = _table(s, where, f"{key}[{i}]")
+        out.append(
+            (
+                _str(_need(entry, where, "name", f"{key}[{i}]."), where, f"{key}[{i}].name"),
+                _int(_need(entry, where, "open", f"{key}[{i}]."), where, f"{key}[{i}].open"),
+            )
+        )
+    return tuple(out)
+
+
+def _note_number(key: str, where: str) -> int:
+    if not (key.isascii() and key.isdigit() and 0 <= int(key) <= 127):
+        raise ConfigError(f"{where}: notes.{key}: a note key must be a MIDI note number 0-127")
+    return int(key)
+
+
+def parse_kit(data: dict[str, Any], *, where: str = "drum_kit.toml") -> DrumKit:
+    """The kit of a ``drum_kit.toml`` table."""
+    prio = _table(data.get("priority", {}), where, "priority")
     notes: dict[int, DrumNote] = {}
-    for key, entry in data.get("notes", {}).items():
-        piece = str(entry["piece"])
-        limb = entry.get("limb")
+    for key, value in _table(data.get("notes", {}), where, "notes").items():
+        k = f"notes.{key}"
+        entry = _table(value, where, k)
+        piece = _str(_need(entry, where, "piece", f"{k}."), where, f"{k}.piece")
+        limb = _opt_str(entry.get("limb"), where, f"{k}.limb")
         if limb is None and piece not in HAND_PIECES:
-            raise ConfigError(f"drum note {key}: piece {piece!r} is not a hand piece")
+            raise ConfigError(f"{where}: drum note {key}: piece {piece!r} is not a hand piece")
         if limb is not None and (piece, limb) not in FOOT_KINDS:
-            raise ConfigError(f"drum note {key}: {piece} cannot be played by {limb}")
-        notes[int(key)] = DrumNote(
+            raise ConfigError(f"{where}: drum note {key}: {piece} cannot be played by {limb}")
+        if "priority" in entry:
+            priority = _int(entry["priority"], where, f"{k}.priority")
+        else:
+            priority = _int(prio.get(piece, 5), where, f"priority.{piece}")
+        notes[_note_number(key, where)] = DrumNote(
             piece=piece,
             limb=limb,
-            priority=int(entry.get("priority", prio.get(piece, 5))),
-            articulation=entry.get("articulation"),
-            name=str(entry.get("name", "")),
+            priority=priority,
+            articulation=_opt_str(entry.get("articulation"), where, f"{k}.articulation"),
+            name=_str(entry.get("name", ""), where, f"{k}.name"),
         )
     return DrumKit(notes)
 
 
-def parse_costs(data: dict[str, Any]) -> DrumCosts:
-    motions = tuple(str(m) for m in data["motions"])
+def parse_costs(data: dict[str, Any], *, where: str = "drum_costs.toml") -> DrumCosts:
+    """The hand cost table of a ``drum_costs.toml`` table (every cost a finite number)."""
+    motions_list = _list(_need(data, where, "motions"), where, "motions")
+    motions = tuple(_str(m, where, f"motions[{i}]") for i, m in enumerate(motions_list))
     expected = {f"{p}_{h}" for p in HAND_PIECES for h in HANDS}
     if set(motions) != expected or len(motions) != 14:
-        raise ConfigError("drum cost table: motions must be the 14 <piece>_<hand> motions")
-    rows = data["rows"]
+        raise ConfigError(f"{where}: motions must be the 14 <piece>_<hand> motions")
+    rows = _table(_need(data, where, "rows"), where, "rows")
     table = []
     for row_name in (*motions, "none"):
-        row = rows.get(row_name)
-        if row is None or set(row) != set(motions):
-            raise ConfigError(f"drum cost table: row {row_name!r} must give all 14 columns")
-        table.append(tuple(float(row[c]) for c in motions))
-    return DrumCosts(motions, tuple(table), float(data.get("drop_penalty", 1000)))
+        if row_name not in rows:
+            raise ConfigError(f"{where}: rows.{row_name} is missing")
+        row = _table(rows[row_name], where, f"rows.{row_name}")
+        if set(row) != set(motions):
+            raise ConfigError(f"{where}: row {row_name!r} must give all 14 columns")
+        table.append(tuple(_float(row[c], where, f"rows.{row_name}.{c}") for c in motions))
+    drop = _float(data.get("drop_penalty", 1000), where, "drop_penalty")
+    return DrumCosts(motions, tuple(table), drop)
 
 
-def parse_timing(data: dict[str, Any]) -> Timing:
-    kinds = {
-        name: MotionTiming(
-            float(v["anticipation_s"]), float(v["min_anticipation_s"]), float(v["min_interval_s"])
+def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
+    """The timing of a ``timing.toml`` table: reference_bpm > 0, rest_s >= 0, and for each
+    kind 0 <= min_anticipation_s <= anticipation_s and min_interval_s >= 0 (all finite)."""
+    kinds = {}
+    for name, value in _table(_need(data, where, "motion"), where, "motion").items():
+        k = f"motion.{name}"
+        v = _table(value, where, k)
+        mt = MotionTiming(
+            *(_float(_need(v, where, f, f"{k}."), where, f"{k}.{f}") for f in _TIMING_FIELDS)
         )
-        for name, v in data["motion"].items()
-    }
-    for name, mt in kinds.items():
         if not 0 <= mt.min_anticipation_s <= mt.anticipation_s:
-            raise ConfigError(f"timing {name}: need 0 <= min_anticipation_s <= anticipation_s")
+            raise ConfigError(f"{where}: {k}: need 0 <= min_anticipation_s <= anticipation_s")
+        if mt.min_interval_s < 0:
+            raise ConfigError(f"{where}: {k}.min_interval_s must be >= 0")
+        kinds[name] = mt
     needed = {*HAND_PIECES, "kick", "hihat_pedal", "pluck"}
     if missing := needed - set(kinds):
-        raise ConfigError(f"timing table lacks motion kinds {sorted(missing)}")
-    return Timing(60.0 / float(data["reference_bpm"]), float(data["rest_s"]), kinds)
+        raise ConfigError(f"{where}: timing table lacks motion kinds {sorted(missing)}")
+    bpm = _float(_need(data, where, "reference_bpm"), where, "reference_bpm")
+    if bpm <= 0:
+        raise ConfigError(f"{where}: reference_bpm must be > 0, got {bpm}")
+    rest_s = _float(_need(data, where, "rest_s"), where, "rest_s")
+    if rest_s < 0:
+        raise ConfigError(f"{where}: rest_s must be >= 0, got {rest_s}")
+    return Timing(60.0 / bpm, rest_s, kinds)
+
+
+_TIMING_FIELDS = ("anticipation_s", "min_anticipation_s", "min_interval_s")
 
 
 def default_config() -> PlanConfig:
@@ -218,17 +336,25 @@ def load_plan_config(path: str | Path | None) -> PlanConfig:
     if path is None:
         return plan_config_from_table({}, None)
     doc = load_config(path)
-    return plan_config_from_table(section(doc, "plan"), Path(path).parent)
+    return plan_config_from_table(section(doc, "plan"), Path(path).parent, where=f"{path} [plan]")
 
 
-def plan_config_from_table(over: dict[str, Any], root: Path | None) -> PlanConfig:
-    """The shipped tables with a ``[plan]`` table's overrides; paths relative to ``root``."""
+def plan_config_from_table(
+    over: dict[str, Any], root: Path | None, *, where: str = "[plan]"
+) -> PlanConfig:
+    """The shipped tables with a ``[plan]`` table's overrides; paths relative to ``root``.
+
+    Every value is type-checked: a wrong type, a non-finite number or a missing key,
+    here or in a table file, is a ConfigError naming the file (``where`` for the
+    overrides) and the key.
+    """
     base = motions_dir()
 
-    def table(key: str, default: str) -> dict[str, Any]:
+    def table(key: str, default: str) -> tuple[dict[str, Any], str]:
+        path = base / default
         if key in over:
-            return _load_toml((root or Path.cwd()) / str(over[key]))
-        return _load_toml(base / default)
+            path = (root or Path.cwd()) / _str(over[key], where, key)
+        return _load_toml(path), str(path)
 
     known = {
         "bass_tuning",
@@ -241,25 +367,29 @@ def plan_config_from_table(over: dict[str, Any], root: Path | None) -> PlanConfi
     }
     if unknown := sorted(set(over) - known):
         raise ConfigError(
-            f"[plan]: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}"
+            f"{where}: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}"
         )
-    try:
-        bass = parse_bass(_load_toml(base / "bass.toml"), tuning=over.get("bass_tuning"))
-        strings = bass.strings
-        if "bass_strings" in over:
-            strings = tuple((str(s["name"]), int(s["open"])) for s in over["bass_strings"])
-        bass = BassSetup(
-            strings,
-            int(over.get("bass_frets", bass.frets)),
-            int(over.get("double_stop_span_frets", bass.double_stop_span_frets)),
-        )
-        return PlanConfig(
-            bass=bass,
-            kit=parse_kit(table("drum_kit", "drum_kit.toml")),
-            costs=parse_costs(table("drum_costs", "drum_costs.toml")),
-            timing=parse_timing(table("timing", "timing.toml")),
-        )
-    except ConfigError:
-        raise
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ConfigError(f"plan configuration invalid: {exc!r}") from None
+    tuning = _opt_str(over.get("bass_tuning"), where, "bass_tuning")
+    bass_path = base / "bass.toml"
+    bass = parse_bass(_load_toml(bass_path), tuning=tuning, where=str(bass_path))
+    strings = bass.strings
+    if "bass_strings" in over:
+        strings = parse_strings(over["bass_strings"], where, "bass_strings")
+    bass = BassSetup(
+        strings,
+        _int(over.get("bass_frets", bass.frets), where, "bass_frets"),
+        _int(
+            over.get("double_stop_span_frets", bass.double_stop_span_frets),
+            where,
+            "double_stop_span_frets",
+        ),
+    )
+    kit, kit_where = table("drum_kit", "drum_kit.toml")
+    costs, costs_where = table("drum_costs", "drum_costs.toml")
+    timing, timing_where = table("timing", "timing.toml")
+    return PlanConfig(
+        bass=bass,
+        kit=parse_kit(kit, where=kit_where),
+        costs=parse_costs(costs, where=costs_where),
+        timing=parse_timing(timing, where=timing_where),
+    )

@@ -182,7 +182,13 @@ def _tsresol(value: int) -> int:
     return 2 ** (value & 0x7F) if value & 0x80 else 10 ** (value & 0x7F)
 
 
-def _idb(order: str, body: bytes) -> _Iface:
+def _idb(path: str, order: str, body: bytes, at: int) -> _Iface:
+    """The interface an IDB body describes; ``at`` is the block's byte offset (for errors).
+
+    Every option's value must lie inside the block: an option that claims more
+    bytes than are left, or an if_tsresol/if_tsoffset of the wrong length, is a
+    corrupt file.
+    """
     linktype = struct.unpack_from(order + "H", body)[0]
     iface = _Iface(linktype)
     off = 8
@@ -190,12 +196,31 @@ def _idb(order: str, body: bytes) -> _Iface:
         code, length = struct.unpack_from(order + "HH", body, off)
         if code == 0:
             break
-        val = body[off + 4 : off + 4 + length]
-        if code == OPT_IF_TSRESOL and length >= 1:
+        start = off + 4
+        if start + length > len(body):
+            raise InputFileError(
+                path,
+                f"corrupt pcapng: interface block at byte {at}: option {code} claims "
+                f"{length} bytes, {len(body) - start} left in the block",
+            )
+        val = body[start : start + length]
+        if code == OPT_IF_TSRESOL:
+            if length != 1:
+                raise InputFileError(
+                    path,
+                    f"corrupt pcapng: interface block at byte {at}: if_tsresol has "
+                    f"{length} bytes, not 1",
+                )
             iface.units_per_s = _tsresol(val[0])
-        elif code == OPT_IF_TSOFFSET and length == 8:
+        elif code == OPT_IF_TSOFFSET:
+            if length != 8:
+                raise InputFileError(
+                    path,
+                    f"corrupt pcapng: interface block at byte {at}: if_tsoffset has "
+                    f"{length} bytes, not 8",
+                )
             iface.offset_s = struct.unpack(order + "q", val)[0]
-        off += 4 + (length + 3) // 4 * 4
+        off = start + (length + 3) // 4 * 4
     return iface
 
 
@@ -235,7 +260,7 @@ def _pcapng(path: str, data: bytes, cap: Capture) -> Iterator[Frame]:
         body = data[off + 8 : off + blen - 4]
         btype = struct.unpack_from(order + "I", data, off)[0]
         if btype == PCAPNG_IDB and len(body) >= 8:
-            ifaces.append(_idb(order, body))
+            ifaces.append(_idb(path, order, body, off))
         elif btype == PCAPNG_EPB and len(body) >= 20:
             if_id, high, low, caplen, _ = struct.unpack_from(order + "IIIII", body)
             if if_id >= len(ifaces):

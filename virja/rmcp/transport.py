@@ -102,7 +102,9 @@ def make_socket(host: str, port: int, *, group: str | None = None) -> socket.soc
 
 def _join(sock: socket.socket, fam: socket.AddressFamily, group: str, iface_host: str) -> None:
     if fam == socket.AF_INET:
-        iface = iface_host if iface_host not in ("", "0.0.0.0", "127.0.0.1") else "0.0.0.0"
+        # join on the interface of the --listen address: 127.0.0.1 (the default)
+        # keeps the group on this host; 0.0.0.0 lets the kernel pick the default one
+        iface = iface_host if iface_host not in ("", "0.0.0.0") else "0.0.0.0"
         mreq = socket.inet_aton(group) + socket.inet_aton(iface)
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, mreq)
     else:

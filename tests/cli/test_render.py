@@ -143,3 +143,22 @@ def test_a_file_without_band_notes_is_refused(tmp_path: Path, capsys: object) ->
         ],
     )
     assert main(["render", str(mid), "--out", str(tmp_path / "x.mp4")]) == 1
+
+
+def test_audio_onset_lines_up_with_the_note_in_the_video(tmp_path: Path) -> None:
+    """The snare at 1.0 s sounds 1.0 s after the video's session-time zero."""
+    import wave
+
+    from virja.render.video import ffmpeg_exe
+
+    mid = one_beat(tmp_path / "one.mid")
+    out = tmp_path / "sync.mp4"
+    # the video starts at -0.5 s: session time 1.0 s is 1.5 s into the file
+    assert main(["render", str(mid), "--out", str(out), "--size", "64x48", "--fps", "10", "--start", "-0.5", "--end", "2.0"]) == 0
+    wav = tmp_path / "sync.wav"
+    subprocess.run([ffmpeg_exe(), "-loglevel", "error", "-y", "-i", str(out), "-vn", "-ac", "1", "-ar", "8000", str(wav)], check=True, timeout=60)
+    with wave.open(str(wav)) as w:
+        pcm = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(float)
+        rate = w.getframerate()
+    onset = int(np.argmax(np.abs(pcm) > 0.05 * np.abs(pcm).max())) / rate
+    assert abs(onset - 1.5) < 0.04, onset  # the soundfont's snare attack takes ~25 ms

@@ -78,9 +78,9 @@ def open_plan_log(path: str | None) -> IO[str] | None:
 class ProgressBar:
     """A one-line progress bar on stderr (every 10 % when stderr is not a terminal)."""
 
-    def __init__(self, label: str, stream: IO[str] = sys.stderr) -> None:
+    def __init__(self, label: str, stream: IO[str] | None = None) -> None:
         self.label = label
-        self.stream = stream
+        self.stream = sys.stderr if stream is None else stream  # looked up now, not at import
         self.tty = stream.isatty()
         self._last_decile = -1
 

@@ -74,6 +74,14 @@ class OffscreenTarget:
         data = self.resolved.read(components=3, alignment=1)
         return np.frombuffer(data, dtype=np.uint8).reshape(h, w, 3)[::-1]
 
+    def read_raw_rgb(self) -> bytes:
+        """The frame as packed RGB bytes, bottom row first (as GL stores it): no copies
+        beyond the read itself; the video writer flips it on the encoder's side."""
+        if self.fbo is not self.resolved:
+            self.ctx.copy_framebuffer(self.resolved, self.fbo)
+        data: bytes = self.resolved.read(components=3, alignment=1)
+        return data
+
     def finish(self) -> None:
         """Wait for the GPU (llvmpipe) to finish the frame, without reading it back."""
         if self.fbo is not self.resolved:

@@ -87,13 +87,29 @@ MESHES: dict[str, Callable[[], F32]] = {
 }
 
 
+def _cross(a: F64, b: F64) -> F64:
+    """Row-wise cross product of (n, 3) arrays; np.cross costs ~30 us a call in set-up."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
+def _row_norm(v: F64) -> F64:
+    return np.sqrt(np.einsum("ij,ij->i", v, v))
+
+
 def _basis_from_y(axis: F64) -> F64:
     """(n, 3, 3) rotations taking +y onto each unit ``axis`` (n, 3)."""
-    y = axis / np.maximum(np.linalg.norm(axis, axis=1, keepdims=True), 1e-12)
-    helper = np.where(np.abs(y[:, 1:2]) < 0.99, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
-    x = np.cross(helper, y)
-    x /= np.maximum(np.linalg.norm(x, axis=1, keepdims=True), 1e-12)
-    z = np.cross(x, y)
+    y = axis / np.maximum(_row_norm(axis), 1e-12)[:, None]
+    helper = np.zeros_like(y)
+    near_y = np.abs(y[:, 1]) >= 0.99
+    helper[~near_y, 1] = 1.0
+    helper[near_y, 0] = 1.0
+    x = _cross(helper, y)
+    x /= np.maximum(_row_norm(x), 1e-12)[:, None]
+    z = _cross(x, y)
     return np.stack([x, y, z], axis=2)  # columns x, y, z
 
 
@@ -103,10 +119,13 @@ def segment_transforms(a: ArrayLike, b: ArrayLike, radius: ArrayLike) -> F64:
     b = np.asarray(b, dtype=np.float64).reshape(-1, 3)
     r = np.broadcast_to(np.asarray(radius, dtype=np.float64), (a.shape[0],))
     d = b - a
-    length = np.linalg.norm(d, axis=1)
-    rot = _basis_from_y(np.where(length[:, None] > 1e-12, d, [[0.0, 1.0, 0.0]]))
+    length = _row_norm(d)
+    d[length <= 1e-12] = (0.0, 1.0, 0.0)
+    rot = _basis_from_y(d)
     m = np.zeros((a.shape[0], 4, 4))
-    m[:, :3, :3] = rot * np.stack([r, length, r], axis=1)[:, None, :]
+    m[:, :3, 0] = rot[:, :, 0] * r[:, None]
+    m[:, :3, 1] = rot[:, :, 1] * length[:, None]
+    m[:, :3, 2] = rot[:, :, 2] * r[:, None]
     m[:, :3, 3] = a
     m[:, 3, 3] = 1.0
     return m

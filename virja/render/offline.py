@@ -15,9 +15,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-from numpy.typing import NDArray
-
 from virja.errors import ConfigError
 from virja.render.camera import Camera
 from virja.render.hosts import OffscreenTarget, create_headless_context
@@ -107,7 +104,9 @@ def render_offline(
     outputs: list[Path] = []
     if out.kind == "video":
         out.path.parent.mkdir(parents=True, exist_ok=True)
-        writer = VideoWriter(out.path, size, fps, audio=audio, audio_offset_s=audio_offset_s)
+        writer = VideoWriter(
+            out.path, size, fps, audio=audio, audio_offset_s=audio_offset_s, bottom_up=True
+        )
         outputs.append(out.path)
     elif out.kind == "folder":
         out.path.mkdir(parents=True, exist_ok=True)
@@ -118,10 +117,11 @@ def render_offline(
         for i, t in enumerate(times):
             feeder.until(perf, t)
             perf.advance(t)
-            frame = draw_frame(renderer, target, static, perf, t, camera)
+            renderer.draw([static, band_scene(perf.pose(t))], camera, target.fbo)
             if writer is not None:
-                writer.write(frame)
+                writer.write_raw(target.read_raw_rgb())
             else:
+                frame = target.read_rgb()
                 path = out.path if out.kind == "png" and len(times) == 1 else out.frame_path(i)
                 write_png(path, frame)
                 outputs.append(path)
@@ -136,19 +136,3 @@ def render_offline(
         renderer.release()
         ctx.release()
     return RenderResult(len(times), time.perf_counter() - started, t0_s, outputs)
-
-
-def draw_frame(
-    renderer: Renderer,
-    target: OffscreenTarget,
-    static: object,
-    perf: Performance,
-    t: float,
-    camera: Camera,
-) -> NDArray[np.uint8]:
-    """One frame of the band at ``t`` as (h, w, 3) uint8."""
-    from virja.render.renderer import DrawList
-
-    assert isinstance(static, DrawList)
-    renderer.draw([static, band_scene(perf.pose(t))], camera, target.fbo)
-    return target.read_rgb()

@@ -46,6 +46,7 @@ SKIN = (0.80, 0.58, 0.45, 0.15)
 DRUMMER_SHIRT = (0.16, 0.30, 0.62, 0.1)
 BASSIST_SHIRT = (0.55, 0.42, 0.12, 0.1)
 TROUSERS = (0.10, 0.10, 0.12, 0.1)
+DANCER_SHIRT = (0.55, 0.10, 0.35, 0.1)
 
 
 def _rotation_to(axis: F64) -> F64:
@@ -198,6 +199,13 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
     dl.add("cylinder", segment_transforms(s[:, 0], s[:, 1], 0.0075), STICK)
     dl.add("sphere", sphere_transforms(s[:, 1], 0.009), STICK)
+    return dl
+
+
+def figure_scene(fig: FigurePose, shirt: tuple[float, ...] = DANCER_SHIRT) -> DrawList:
+    """One more figure (the dancer) as solid limbs, in its own shirt colour."""
+    dl = DrawList()
+    _figure(dl, fig, shirt)
     return dl
 
 

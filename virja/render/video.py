@@ -122,7 +122,8 @@ class VideoWriter:
         audio: Path | None = None,
         audio_offset_s: float = 0.0,
         crf: int = 20,
-        preset: str = "veryfast",
+        preset: str = "superfast",
+        bottom_up: bool = False,
     ) -> None:
         w, h = size
         if w % 2 or h % 2:
@@ -134,14 +135,37 @@ class VideoWriter:
             "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", f"{fps}", "-i", "-",
         ]  # fmt: skip
         if audio is not None:
-            cmd += ["-itsoffset", f"{audio_offset_s:.6f}", "-i", str(audio)]
+            cmd += ["-i", str(audio)]
+        if bottom_up:  # frames as GL reads them: let the encoder flip them
+            cmd += ["-vf", "vflip"]
         cmd += ["-c:v", "libx264", "-preset", preset, "-crf", str(crf), "-pix_fmt", "yuv420p"]
         cmd += ["-threads", "2", "-movflags", "+faststart"]
         if audio is not None:
-            cmd += ["-c:a", "aac", "-b:a", "160k", "-map", "0:v:0", "-map", "1:a:0"]
+            # The offset is baked into the samples (silence padded, or the head cut),
+            # not left to a container start time that some players and decoders
+            # ignore; -shortest: the synth's reverb tail stops at the last frame.
+            if audio_offset_s >= 0:
+                shift = f"adelay=delays={audio_offset_s * 1000:.3f}:all=1"
+            else:
+                shift = f"atrim=start={-audio_offset_s:.6f},asetpts=PTS-STARTPTS"
+            cmd += ["-af", shift, "-c:a", "aac", "-b:a", "160k"]
+            cmd += ["-map", "0:v:0", "-map", "1:a:0", "-shortest"]
         cmd += [str(path)]
         self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         self.frames = 0
+
+    def write_raw(self, data: bytes) -> None:
+        """One frame of packed RGB bytes, in the row order the writer was opened with."""
+        assert self._proc.stdin is not None
+        if len(data) != self.size[0] * self.size[1] * 3:
+            raise ValueError(
+                f"frame of {len(data)} bytes, expected {self.size[0] * self.size[1] * 3}"
+            )
+        try:
+            self._proc.stdin.write(data)
+        except BrokenPipeError as exc:
+            raise NotAvailableError(f"ffmpeg stopped: {self._stderr()}") from exc
+        self.frames += 1
 
     def write(self, rgb: NDArray[np.uint8]) -> None:
         assert self._proc.stdin is not None

@@ -81,7 +81,7 @@ class ProgressBar:
     def __init__(self, label: str, stream: IO[str] | None = None) -> None:
         self.label = label
         self.stream = sys.stderr if stream is None else stream  # looked up now, not at import
-        self.tty = stream.isatty()
+        self.tty = self.stream.isatty()
         self._last_decile = -1
 
     def __call__(self, done: int, total: int, elapsed_s: float) -> None:

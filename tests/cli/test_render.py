@@ -154,9 +154,44 @@ def test_audio_onset_lines_up_with_the_note_in_the_video(tmp_path: Path) -> None
     mid = one_beat(tmp_path / "one.mid")
     out = tmp_path / "sync.mp4"
     # the video starts at -0.5 s: session time 1.0 s is 1.5 s into the file
-    assert main(["render", str(mid), "--out", str(out), "--size", "64x48", "--fps", "10", "--start", "-0.5", "--end", "2.0"]) == 0
+    assert (
+        main(
+            [
+                "render",
+                str(mid),
+                "--out",
+                str(out),
+                "--size",
+                "64x48",
+                "--fps",
+                "10",
+                "--start",
+                "-0.5",
+                "--end",
+                "2.0",
+            ]
+        )
+        == 0
+    )
     wav = tmp_path / "sync.wav"
-    subprocess.run([ffmpeg_exe(), "-loglevel", "error", "-y", "-i", str(out), "-vn", "-ac", "1", "-ar", "8000", str(wav)], check=True, timeout=60)
+    subprocess.run(
+        [
+            ffmpeg_exe(),
+            "-loglevel",
+            "error",
+            "-y",
+            "-i",
+            str(out),
+            "-vn",
+            "-ac",
+            "1",
+            "-ar",
+            "8000",
+            str(wav),
+        ],
+        check=True,
+        timeout=60,
+    )
     with wave.open(str(wav)) as w:
         pcm = np.frombuffer(w.readframes(w.getnframes()), dtype=np.int16).astype(float)
         rate = w.getframerate()

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from virja.cli.common import (
     ProgressBar,
@@ -28,6 +29,9 @@ from virja.cli.common import (
 )
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
+
+if TYPE_CHECKING:
+    from virja.dance.stage import DancerTrack
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -85,7 +89,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--bvh", metavar="OUT.bvh", help="also export the band's performed motion as BVH"
     )
+    add_dancer_argument(p)
     add_routing_arguments(p)
+
+
+def add_dancer_argument(p: argparse.ArgumentParser) -> None:
+    """--dancer DB (shared with `virja replay`)."""
+    p.add_argument(
+        "--dancer",
+        metavar="DB",
+        help="also draw a dancer, front centre, whose motion method B generates from the "
+        "session's audio with this database (`virja teach`); needs fluidsynth and a soundfont",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -139,6 +154,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         # everything known before the frame must have been fed: start the feeder there
     if t1 < t0:
         raise ConfigError(f"nothing to render: end {t1:.3f} s is before start {t0:.3f} s")
+    dancer_db = getattr(args, "dancer", None)
     with temp_workdir() as tmp:
         audio = None
         if out.kind == "video" and not args.no_audio:
@@ -148,7 +164,15 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             if why_not:
                 print(f"virja: {why_not}", file=sys.stderr)
         progress = ProgressBar("rendering") if out.kind != "png" or args.at is None else None
-        result = render_offline(
+        render = render_offline
+        if dancer_db is not None:
+            from functools import partial
+
+            from virja.render.dancer import render_with_dancer
+
+            track = session_dancer(src, dancer_db, audio, Path(tmp), args.soundfont)
+            render = partial(render_with_dancer, dancer=track.pose)
+        result = render(
             perf,
             feeder,
             t0_s=t0,
@@ -177,3 +201,26 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )
     return 0
+
+
+def session_dancer(
+    src: object, db_path: str, wav: Path | None, workdir: Path, soundfont: str | None
+) -> DancerTrack:
+    """The dancer for `--dancer DB`: the session's audio (``wav`` if already rendered),
+    method B generation, placed front centre; frame 0 at the audio's t = 0."""
+    from virja.dance.audio import read_audio_8k
+    from virja.dance.database import load_database
+    from virja.dance.stage import dance_to_audio
+    from virja.errors import NotAvailableError
+    from virja.input import PerformanceInput
+    from virja.render.video import make_audio_track
+
+    assert isinstance(src, PerformanceInput)
+    db = load_database(db_path)
+    if wav is None:
+        wav, why_not = make_audio_track(src.sound_events, src.sound_origin_s, workdir, soundfont)
+        if wav is None:
+            raise NotAvailableError(f"--dancer needs the session's audio: {why_not}")
+    track, g = dance_to_audio(db, read_audio_8k(wav), t0_s=src.sound_origin_s)
+    print(f"dancer: {len(g.beats_s)} beats, {len(g.intervals)} segments from {db_path}")
+    return track

@@ -44,6 +44,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-audio", action="store_true")
     p.add_argument("--soundfont", metavar="FILE.sf2")
     p.add_argument("--samples", type=int, default=1, help="multisampling (default 1 = off)")
+    from virja.cli.cmd_render import add_dancer_argument
+
+    add_dancer_argument(p)
     add_routing_arguments(p)
 
 
@@ -53,6 +56,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.port is not None and not 1 <= args.port <= 65535:
         raise ConfigError(f"--port must be 1-65535, got {args.port}")
+    if args.dancer and not args.out:
+        raise ConfigError("--dancer draws into a rendering: give --out too")
     src = pcap_input(Path(args.input), routing_config(args), port=args.port, key_file=args.key_file)
     for line in src.report:
         print(line)

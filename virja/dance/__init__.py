@@ -6,7 +6,9 @@ Modules: :mod:`~virja.dance.audio` (read, mono, 8 kHz), :mod:`~virja.dance.beats
 (the {segment, sound parameters, span} store), :mod:`~virja.dance.intervals`
 (beat-interval correction), :mod:`~virja.dance.generate` (choosing and joining
 segments), :mod:`~virja.dance.evaluate` (objective scores),
-:mod:`~virja.dance.synth` (synthetic teachers and music for tests) and
+:mod:`~virja.dance.synth_capture` / :mod:`~virja.dance.synth_music` (synthetic
+teachers and music for tests), :mod:`~virja.dance.band_capture` (our own band
+as teacher), :mod:`~virja.dance.stage` (a dance as a figure on stage) and
 :mod:`~virja.dance.bench`.  See docs/dance.md.
 """
 

@@ -33,7 +33,7 @@ def create_headless_context() -> moderngl.Context:
         ) from exc
 
 
-def _parking_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
+def parking_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
     """A 1x1 framebuffer kept for the context's life, bound while others are deleted."""
     extra = ctx.extra if isinstance(ctx.extra, dict) else {}
     ctx.extra = extra
@@ -91,7 +91,7 @@ class OffscreenTarget:
     def release(self) -> None:
         # Deleting the bound framebuffer leaves GL pointing at nothing, and the next
         # framebuffer made fails with GL_INVALID_OPERATION: bind a parked 1x1 one first.
-        _parking_framebuffer(self.ctx).use()
+        parking_framebuffer(self.ctx).use()
         for fb in {id(self.fbo): self.fbo, id(self.resolved): self.resolved}.values():
             for att in fb.color_attachments:
                 att.release()

@@ -19,7 +19,7 @@ from virja.errors import ConfigError
 from virja.render.camera import Camera
 from virja.render.hosts import OffscreenTarget, create_headless_context
 from virja.render.images import write_png
-from virja.render.renderer import Renderer
+from virja.render.renderer import DrawList, Renderer
 from virja.render.scene import band_scene, static_scene
 from virja.render.video import VideoWriter
 from virja.session import Performance, RevealFeeder, frame_times
@@ -77,29 +77,32 @@ class RenderResult:
     outputs: list[Path]
 
 
-def render_offline(
-    perf: Performance,
-    feeder: RevealFeeder,
+SceneAt = Callable[[float], list[DrawList]]
+
+
+def render_frames(
+    times: list[float],
+    scene_at: SceneAt,
     *,
-    t0_s: float,
-    t1_s: float,
     fps: float,
     size: tuple[int, int],
     out: OutputSpec,
     camera: Camera,
     audio: Path | None = None,
     audio_offset_s: float = 0.0,
-    samples: int = 4,
+    samples: int = 1,
     progress: Progress | None = None,
-) -> RenderResult:
-    """Drive ``perf`` from t0 to t1 at ``fps`` and write each frame to ``out``."""
-    times = list(frame_times(t0_s, t1_s, fps))
+) -> tuple[float, list[Path]]:
+    """Draw ``scene_at(t)`` for each frame time and write it to ``out``.
+
+    The one frame loop of every offline render (band, band and dancer, dancer
+    alone).  Returns the seconds it took and the files written.
+    """
     if out.kind == "video" and (size[0] % 2 or size[1] % 2):
         raise ConfigError(f"video needs an even frame size, got {size[0]}x{size[1]}")
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     target = OffscreenTarget(ctx, size, samples=samples)
-    static = static_scene()
     writer: VideoWriter | None = None
     outputs: list[Path] = []
     if out.kind == "video":
@@ -115,24 +118,65 @@ def render_offline(
     started = time.perf_counter()
     try:
         for i, t in enumerate(times):
-            feeder.until(perf, t)
-            perf.advance(t)
-            renderer.draw([static, band_scene(perf.pose(t))], camera, target.fbo)
+            renderer.draw(scene_at(t), camera, target.fbo)
             if writer is not None:
-                writer.write_raw(target.read_raw_rgb())
+                writer.write_raw(target.read_raw_rgb())  # GL row order; ffmpeg flips
             else:
-                frame = target.read_rgb()
                 path = out.path if out.kind == "png" and len(times) == 1 else out.frame_path(i)
-                write_png(path, frame)
+                write_png(path, target.read_rgb())
                 outputs.append(path)
             if progress is not None:
                 progress(i + 1, len(times), time.perf_counter() - started)
-        feeder.until(perf, math.inf)
-        perf.finish()
     finally:
         if writer is not None:
             writer.close()
         target.release()
         renderer.release()
         ctx.release()
-    return RenderResult(len(times), time.perf_counter() - started, t0_s, outputs)
+    return time.perf_counter() - started, outputs
+
+
+def render_offline(
+    perf: Performance,
+    feeder: RevealFeeder,
+    *,
+    t0_s: float,
+    t1_s: float,
+    fps: float,
+    size: tuple[int, int],
+    out: OutputSpec,
+    camera: Camera,
+    audio: Path | None = None,
+    audio_offset_s: float = 0.0,
+    samples: int = 1,
+    progress: Progress | None = None,
+    extra: SceneAt | None = None,
+) -> RenderResult:
+    """Drive ``perf`` from t0 to t1 at ``fps`` and write each frame to ``out``.
+
+    ``extra(t)`` adds instances to each frame (the dancer, for one).
+    """
+    times = list(frame_times(t0_s, t1_s, fps))
+    static = static_scene()
+
+    def scene_at(t: float) -> list[DrawList]:
+        feeder.until(perf, t)
+        perf.advance(t)
+        layers = [static, band_scene(perf.pose(t))]
+        return layers if extra is None else layers + extra(t)
+
+    seconds, outputs = render_frames(
+        times,
+        scene_at,
+        fps=fps,
+        size=size,
+        out=out,
+        camera=camera,
+        audio=audio,
+        audio_offset_s=audio_offset_s,
+        samples=samples,
+        progress=progress,
+    )
+    feeder.until(perf, math.inf)
+    perf.finish()
+    return RenderResult(len(times), seconds, t0_s, outputs)

@@ -160,6 +160,9 @@ class Renderer:
     def _release_layer(self) -> None:
         if self._layer is None:
             return
+        from virja.render.hosts import parking_framebuffer
+
+        parking_framebuffer(self.ctx).use()  # never delete the bound framebuffer
         for att in self._layer.color_attachments:
             att.release()
         if self._layer.depth_attachment is not None:

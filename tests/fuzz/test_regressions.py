@@ -248,3 +248,16 @@ def test_sidecar_impact_must_be_finite_and_not_negative(tmp_path: Path, value: s
     )
     with pytest.raises(ClipError, match="impact_s must be finite and >= 0"):
         read_sidecar(p)
+
+
+def test_bvh_repeated_rotation_channel_is_bvh_error() -> None:
+    """Found by the BVH fuzzer: 'Yrotation Yrotation Zrotation' reached the Euler
+    conversion and raised a plain ValueError there."""
+    from virja.motion.bvh import BvhError, parse_bvh
+
+    text = (
+        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Yrotation Yrotation Zrotation\n"
+        "  End Site\n  {\n    OFFSET 0 1 0\n  }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n"
+    )
+    with pytest.raises(BvhError, match="channel twice"):
+        parse_bvh(text, "dup.bvh")

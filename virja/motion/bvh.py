@@ -162,6 +162,8 @@ def _joint_header(tk: _Tokens, name: str, parent: int) -> BvhJoint:
         if ch not in _ROT and ch not in _POS:
             raise BvhError(tk.path, line, f"unknown channel {ch!r} in joint {name!r}")
         channels.append(ch)
+    if len(set(channels)) != len(channels):
+        raise BvhError(tk.path, line, f"joint {name!r} lists a channel twice: {' '.join(channels)}")
     rot = [c for c in channels if c in _ROT]
     if rot and len(rot) != 3:
         raise BvhError(

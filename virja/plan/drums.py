@@ -172,30 +172,30 @@ def solve(
     table = costs.table
     none_row = costs.none_row
     best: dict[HandState, float] = {state: 0.0}
-    backs: list[dict[HandState, tuple[HandState, Assignment, tuple[float, ...]]]] = []
+    # back-pointers keep (previous state, option index); the per-stroke costs are
+    # recomputed once on the way back instead of being built for every candidate
+    backs: list[dict[HandState, tuple[HandState, int]]] = []
+    compiled_all = []
     for group in groups:
         t = group.time
         compiled = _compiled(costs, timing, group)
-        n = len(group.strokes)
+        compiled_all.append(compiled)
         nxt: dict[HandState, float] = {}
-        back: dict[HandState, tuple[HandState, Assignment, tuple[float, ...]]] = {}
+        back: dict[HandState, tuple[HandState, int]] = {}
         for st, acc in best.items():
             prev, prev_t, t_right, t_left = st
             row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
-            for assign, played, penalty in compiled:
+            for k, (_assign, played, penalty) in enumerate(compiled):
                 row = row0
                 tr, tl = t_right, t_left
                 total = acc + penalty
-                per = [0.0] * n
                 ok = True
-                for is_right, m, min_int, i in played:
+                for is_right, m, min_int, _i in played:
                     last = tr if is_right else tl
                     if last is not None and t - last < min_int:
                         ok = False
                         break
-                    c = table[none_row if row is None else row][m]
-                    per[i] = c
-                    total += c
+                    total += table[none_row if row is None else row][m]
                     row = m
                     if is_right:
                         tr = t
@@ -218,7 +218,7 @@ def solve(
                 old = nxt.get(new)
                 if old is None or total < old:
                     nxt[new] = total
-                    back[new] = (st, assign, tuple(per))
+                    back[new] = (st, k)
         best = nxt
         backs.append(back)
     end = min(best, key=lambda s: best[s])
@@ -227,10 +227,23 @@ def solve(
     pers: list[tuple[float, ...]] = []
     states: list[HandState] = []
     cur = end
-    for back in reversed(backs):
-        prev_st, assign, paid = back[cur]
+    for group, compiled, back in zip(
+        reversed(groups), reversed(compiled_all), reversed(backs), strict=True
+    ):
+        prev_st, k = back[cur]
+        assign, played, _penalty = compiled[k]
+        prev, prev_t = prev_st[0], prev_st[1]
+        row = (
+            prev
+            if prev is not None and prev_t is not None and group.time - prev_t < rest_s
+            else None
+        )
+        per = [0.0] * len(group.strokes)
+        for _is_right, m, _min_int, i in played:
+            per[i] = table[none_row if row is None else row][m]
+            row = m
         assigns.append(assign)
-        pers.append(paid)
+        pers.append(tuple(per))
         states.append(cur)
         cur = prev_st
     return HandSolution(

@@ -241,3 +241,15 @@ def test_feet_play_kick_and_hihat_pedal() -> None:
 def test_unmapped_drum_note_is_reported() -> None:
     planned, report = plan_notes_with_report([("drums", NoteOn(0.0, 9, 20, 100))], T120)
     assert planned == [] and [d.reason for d in report.dropped] == ["unmapped"]
+
+
+def test_a_long_session_keeps_bounded_tempo_and_report_history() -> None:
+    """Hours of beats and drops must not grow the planner without bound."""
+    from virja.events import Beat
+    from virja.plan import planner as planner_mod
+
+    p = planner_mod.OnlinePlanner()
+    for i in range(planner_mod.MAX_BEATS_KEPT + 500):
+        p.add_beat(Beat(i * 0.5, i // 4, 1 + i % 4, 4, 0, 500_000))
+    assert len(p._beat_times) == planner_mod.MAX_BEATS_KEPT
+    assert p.seconds_per_beat_at(1e9) == 0.5

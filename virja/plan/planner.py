@@ -13,7 +13,9 @@ So the result does not depend on how often ``poll`` is called, and
 
 from __future__ import annotations
 
+import bisect
 import logging
+from collections import Counter, deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,6 +32,8 @@ log = logging.getLogger(__name__)
 
 GROUP_EPS_S = 0.001  # notes this close sound together (one group, one stroke per piece)
 HISTORY = 64  # fixed hand strokes kept for notes that arrive out of order
+MAX_BEATS_KEPT = 1024  # tempo history: minutes of beats, far past the 10 s horizon
+MAX_REPORTED = 10_000  # dropped and moved notes kept for the report (totals are counted)
 
 _default_config: PlanConfig | None = None
 
@@ -92,28 +96,33 @@ class OnlinePlanner:
     def __init__(self, config: PlanConfig | None = None, *, tempo: Tempo | None = None) -> None:
         self.config = _config(config)
         self._tempo = tempo
-        self._beats: list[tuple[float, float]] = []
+        self._beat_times: list[float] = []  # sorted; at most MAX_BEATS_KEPT, the latest
+        self._beat_spb: list[float] = []
         self._chains = {n: _Chain(n) for n in ("bass", "hands", "right_foot", "left_foot")}
         self._chains["hands"].state = drums_mod.START
         self._outbox: list[PlannedNote] = []
-        self._dropped: list[DroppedNote] = []
-        self._moved: list[MovedNote] = []
+        self._dropped: deque[DroppedNote] = deque(maxlen=MAX_REPORTED)
+        self._moved: deque[MovedNote] = deque(maxlen=MAX_REPORTED)
+        self._counts: Counter[str] = Counter()
         self._seq = 0
 
     # -- inputs ---------------------------------------------------------------
 
     def add_beat(self, beat: Beat) -> None:
         """A beat of the session: its tempo applies from its time on."""
-        self._beats.append((beat.time_s, beat.seconds_per_beat))
-        self._beats.sort(key=lambda b: b[0])
+        i = bisect.bisect_right(self._beat_times, beat.time_s)
+        self._beat_times.insert(i, beat.time_s)
+        self._beat_spb.insert(i, beat.seconds_per_beat)
+        if len(self._beat_times) > MAX_BEATS_KEPT:  # a daemon runs for hours: keep the latest
+            del self._beat_times[0], self._beat_spb[0]
 
     def seconds_per_beat_at(self, time_s: float) -> float:
-        before = [spb for t, spb in self._beats if t <= time_s]
-        if before:
-            return before[-1]
+        i = bisect.bisect_right(self._beat_times, time_s)
+        if i > 0:
+            return self._beat_spb[i - 1]
         if self._tempo is not None:
             return self._tempo.seconds_per_beat_at(time_s)
-        return self._beats[0][1] if self._beats else DEFAULT_SECONDS_PER_BEAT
+        return self._beat_spb[0] if self._beat_spb else DEFAULT_SECONDS_PER_BEAT
 
     def add_note(self, performer: Performer, note: NoteOn, *, now_s: float) -> None:
         """A note for ``performer`` that sounds at ``note.time_s``, known since ``now_s``."""
@@ -148,7 +157,9 @@ class OnlinePlanner:
     @property
     def report(self) -> PlanReport:
         """Notes dropped or moved so far."""
-        return PlanReport(tuple(self._dropped), tuple(self._moved))
+        return PlanReport(
+            tuple(self._dropped), tuple(self._moved), tuple(sorted(self._counts.items()))
+        )
 
     @property
     def pending_count(self) -> int:
@@ -165,6 +176,8 @@ class OnlinePlanner:
             reason,
         )
         self._dropped.append(DroppedNote(rec.performer, rec.note, reason))
+        self._counts["dropped"] += 1
+        self._counts[f"dropped_{reason}"] += 1
 
     def _make_rec(self, performer: Performer, note: NoteOn, now_s: float) -> _Rec | None:
         self._seq += 1
@@ -174,11 +187,14 @@ class OnlinePlanner:
             if played != note.note:
                 log.info("bass note %d out of range: played as %d", note.note, played)
                 self._moved.append(MovedNote(performer, note, played))
+                self._counts["moved"] += 1
             rec = _Rec(self._seq, performer, note, now_s, "bass", "pluck", played)
         elif performer == "drums":
             dn = self.config.kit.lookup(note.note)
             if dn is None:
                 self._dropped.append(DroppedNote(performer, note, "unmapped"))
+                self._counts["dropped"] += 1
+                self._counts["dropped_unmapped"] += 1
                 log.info("drum note %d not in the kit map: dropped", note.note)
                 return None
             chain = dn.limb or "hands"

@@ -120,13 +120,23 @@ class MovedNote:
 
 @dataclass(frozen=True)
 class PlanReport:
-    """Everything the planner did not play as written."""
+    """Everything the planner did not play as written.
+
+    ``dropped`` and ``moved`` hold the most recent cases (a long-running daemon
+    keeps a bounded number); ``counts``, when given, holds the totals since the
+    start, which :meth:`summary` reports.
+    """
 
     dropped: tuple[DroppedNote, ...] = field(default_factory=tuple)
     moved: tuple[MovedNote, ...] = field(default_factory=tuple)
+    counts: tuple[tuple[str, int], ...] | None = None
 
     def summary(self) -> dict[str, int]:
         """Counts by kind: ``{"dropped": n, "moved": m, "dropped_<reason>": k, ...}``."""
+        if self.counts is not None:
+            out = {"dropped": 0, "moved": 0}
+            out.update(dict(self.counts))
+            return out
         out = {"dropped": len(self.dropped), "moved": len(self.moved)}
         for d in self.dropped:
             key = f"dropped_{d.reason}"

@@ -39,6 +39,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--key-file", default=None, metavar="PATH", help="sign with this HMAC key")
     parser.add_argument("--loop", action="store_true", help="start again at the end, forever")
     parser.add_argument(
+        "--bind",
+        default=None,
+        metavar="HOST:PORT",
+        help="local address to send from and answer clock requests on "
+        "(default: any address, a free port); give it to `virja serve --clock-server`",
+    )
+    parser.add_argument(
         "--start-in",
         type=float,
         default=1.0,
@@ -63,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     if args.sender is not None and not 0 <= args.sender <= 65535:
         raise ConfigError("--sender must be 0-65535")
     host, port = parse_hostport(args.to)
+    bind = parse_hostport(args.bind) if args.bind else None
     key = load_key(args.key_file) if args.key_file else None
     session = read_midi(args.file)
     options = SendOptions(lead_beats=args.lead_beats, sender=args.sender)
@@ -88,6 +96,10 @@ def run(args: argparse.Namespace) -> int:
                 start_in_s=args.start_in,
                 loop=args.loop,
                 key=key,
+                bind=bind,
+                on_bound=lambda a: print(
+                    f"virja send: answering clock requests on {a[0]}:{a[1]}", flush=True
+                ),
             )
         )
     except OSError as exc:

@@ -70,6 +70,8 @@ async def stream(
     key: bytes | None = None,
     max_passes: int | None = None,
     on_sent: Callable[[Scheduled], None] | None = None,
+    bind: tuple[str, int] | None = None,
+    on_bound: Callable[[tuple[str, int]], None] | None = None,
 ) -> StreamStats:
     """Stream the performance to ``to``; returns when done (or runs forever with ``loop``)."""
     stats = StreamStats()
@@ -79,7 +81,11 @@ async def stream(
     sock = socket.socket(family, socket.SOCK_DGRAM)
     if family == socket.AF_INET:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_BROADCAST, 1)
-    sock.bind(("::" if family == socket.AF_INET6 else "0.0.0.0", 0))
+    # the socket clock requests are answered on: --bind, else any address, a free port
+    sock.bind(bind if bind is not None else ("::" if family == socket.AF_INET6 else "0.0.0.0", 0))
+    if on_bound is not None:
+        name = sock.getsockname()
+        on_bound((str(name[0]), int(name[1])))
     sock.setblocking(False)
     transport, _ = await aloop.create_datagram_endpoint(
         lambda: _SendProtocol(clock, key, options.conductor, stats), sock=sock

@@ -37,6 +37,21 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 NOT_YET = 2
 
+DESCRIPTION = """\
+virja: a virtual jazz band's bassist and drummer, drawn playing the notes you send.
+
+Notes arrive over RMCP/1 (UDP), from MIDI files, from a MIDI keyboard, or from
+pcap recordings; a cost-table scheduler picks the string and fret or the hand
+for each, and every stroke and pluck lands on its sound."""
+
+EPILOG = """\
+examples:
+  virja render virja/demo/blues.mid --out out/demo.mp4
+  virja serve --headless --plan-log plan.jsonl      # and, in another shell:
+  virja send virja/demo/blues.mid --to 127.0.0.1:50500
+
+`virja COMMAND --help` tells more; docs/ in the source tree has the rest."""
+
 
 def _module_doc(modname: str) -> str | None:
     try:
@@ -51,7 +66,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The argument parser; with ``only`` just that subcommand's module is imported."""
     parser = argparse.ArgumentParser(
         prog="virja",
-        description=__doc__.splitlines()[0] if __doc__ else None,
+        description=DESCRIPTION,
+        epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"virja {__version__}")

@@ -103,11 +103,14 @@ class Daemon:
     def on_events(self, received: list[Any], now_s: float) -> None:
         from virja.events import NoteOn
 
+        band = False
         for rec in received:
-            self.perf.feed(rec.event, now_s=rec.arrival_s)
+            if self.perf.feed(rec.event, now_s=rec.arrival_s) is not None:
+                band = True
             if rec.late and isinstance(rec.event, NoteOn):
                 self.late_notes += 1
-        self.perf.advance(now_s)
+        if band:  # plan at once; other traffic waits for the next tick
+            self.perf.advance(now_s)
 
     def tick(self) -> None:
         now_us = self.clock.now_us()

@@ -96,8 +96,30 @@ def make_socket(host: str, port: int, *, group: str | None = None) -> socket.soc
     except OSError as exc:
         sock.close()
         raise ConfigError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
+    _grow_receive_buffer(sock)
     sock.setblocking(False)
     return sock
+
+
+RECEIVE_BUFFER_BYTES = 4 * 1024 * 1024
+
+
+def _grow_receive_buffer(sock: socket.socket) -> None:
+    """Ask for a 4 MiB receive buffer, so bursts (thousands of datagrams a second)
+    ride out a busy moment of the event loop; the kernel may grant less
+    (net.core.rmem_max), which is logged."""
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RECEIVE_BUFFER_BYTES)
+    except OSError as exc:
+        log.info("could not set the receive buffer: %s", exc)
+        return
+    got = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+    if got < RECEIVE_BUFFER_BYTES:
+        log.info(
+            "receive buffer %d bytes (asked %d; raise net.core.rmem_max for more)",
+            got,
+            RECEIVE_BUFFER_BYTES,
+        )
 
 
 def _join(sock: socket.socket, fam: socket.AddressFamily, group: str, iface_host: str) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import random
 import socket
 import subprocess
 import sys
@@ -68,6 +69,13 @@ def main() -> int:
     ap.add_argument("--rate", type=float, default=5000.0, help="datagrams per second (5000)")
     ap.add_argument("--seconds", type=float, default=60.0, help="how long (60)")
     ap.add_argument("--bpm", type=float, default=200.0)
+    ap.add_argument(
+        "--invalid-share",
+        type=float,
+        default=0.0,
+        help="fraction of the other traffic that is junk: random bytes, and valid-looking "
+        "datagrams from ever new sender ids (the receiver's per-sender state must stay bounded)",
+    )
     args = ap.parse_args()
     if not (0 < args.rate <= 50_000 and 0 < args.seconds <= 600):
         ap.error("--rate must be in (0, 50000] and --seconds in (0, 600]")
@@ -103,6 +111,7 @@ def main() -> int:
     spb = 60.0 / args.bpm
     step_s = spb / 4
     seqs: dict[int, int] = {}
+    junk_rng = random.Random(1)
     sent = 0
     band = 0
     tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -130,6 +139,18 @@ def main() -> int:
                     time_us = t0_us + round((next_step * step_s + spb) * 1e6)  # a beat ahead
                     next_step += 1
                     band += len(msgs)
+                elif junk_rng.random() < args.invalid_share:
+                    other_i += 1
+                    if other_i % 2:
+                        tx.sendto(
+                            junk_rng.randbytes(junk_rng.randrange(0, 64)), ("127.0.0.1", port)
+                        )
+                    else:  # a valid datagram from a sender never seen before
+                        fresh = 20 + other_i % 60000
+                        d = wire.midi(fresh, 0, clock.now_us() + 20_000, bytes([0xB0, 7, 100]))
+                        tx.sendto(bytes(d), ("127.0.0.1", port))
+                    sent += 1
+                    continue
                 else:
                     msgs = [other_message(other_i)]
                     other_i += 1
@@ -163,6 +184,9 @@ def main() -> int:
         print(f"RSS (KB): first {rss[0]}, max {max(rss)}, last {rss[-1]}")
     lost = sent - summary.received
     print(f"lost: {lost} ({lost / max(sent, 1):.3%})")
+    if rss and max(rss) - rss[0] > 10_000:
+        print("memory grew by more than 10 MB")
+        return 1
     return 0 if lost == 0 and len(cap.datagrams) == sent and rc == 0 else 1
 
 

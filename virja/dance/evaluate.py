@@ -28,6 +28,7 @@ from virja.dance.audio import FloatArray
 from virja.dance.segment import local_minima
 from virja.motion import quat
 from virja.motion.bvh import Bvh
+from virja.motion.bvh import world_pose as bvh_world_pose
 
 BEAT_SIGMA_S = 0.1
 SPEED_SMOOTH_FRAMES = 2.0
@@ -37,18 +38,7 @@ WINDOW_HOP = 30
 
 def world_positions(bvh: Bvh) -> FloatArray:
     """(n_frames, n_joints, 3) world positions of every joint (file units)."""
-    n, J = bvh.rotations.shape[:2]
-    wrot = np.empty_like(bvh.rotations)
-    wpos = np.empty((n, J, 3))
-    for j, joint in enumerate(bvh.joints):  # BVH lists parents before children
-        p = joint.parent
-        if p < 0:
-            wrot[:, j] = bvh.rotations[:, j]
-            wpos[:, j] = bvh.positions[:, j]
-        else:
-            wrot[:, j] = quat.multiply(wrot[:, p], bvh.rotations[:, j])
-            wpos[:, j] = wpos[:, p] + quat.rotate(wrot[:, p], bvh.positions[:, j])
-    return wpos
+    return bvh_world_pose(bvh)[0]
 
 
 def motion_beats(bvh: Bvh, smooth_frames: float = SPEED_SMOOTH_FRAMES) -> FloatArray:

@@ -23,6 +23,7 @@ from virja.dance.database import DanceDatabase
 from virja.dance.generate import Generated, generate
 from virja.motion import quat
 from virja.motion.bvh import Bvh
+from virja.motion.bvh import world_pose as bvh_world_pose
 from virja.motion.pose import FigurePose
 from virja.motion.skeleton import SKELETON
 
@@ -35,18 +36,7 @@ DEFAULT_RADIUS_M = 0.04
 
 def world_pose(bvh: Bvh) -> tuple[FloatArray, FloatArray]:
     """World positions (n, J, 3) and rotations (n, J, 4, w x y z) of every frame."""
-    n, n_j = bvh.rotations.shape[:2]
-    wrot = np.empty_like(bvh.rotations)
-    wpos = np.empty((n, n_j, 3))
-    for j, joint in enumerate(bvh.joints):  # BVH lists parents before children
-        p = joint.parent
-        if p < 0:
-            wrot[:, j] = bvh.rotations[:, j]
-            wpos[:, j] = bvh.positions[:, j]
-        else:
-            wrot[:, j] = quat.multiply(wrot[:, p], bvh.rotations[:, j])
-            wpos[:, j] = wpos[:, p] + quat.rotate(wrot[:, p], bvh.positions[:, j])
-    return wpos, wrot
+    return bvh_world_pose(bvh)
 
 
 def _radii(names: Sequence[str]) -> FloatArray:

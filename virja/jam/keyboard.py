@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from virja.errors import ConfigError
-from virja.events import ControlChange, NoteOff, NoteOn, Performer, ProgramChange
+from virja.events import ControlChange, NoteOff, NoteOn, Performer, ProgramChange, midi_bytes
 
 LiveEvent = NoteOn | NoteOff | ControlChange | ProgramChange
 UpperMode = Literal["ignore", "drums"]
@@ -131,13 +131,9 @@ def decode(data: Sequence[int], *, time_s: float) -> LiveEvent | None:
 
 def encode(event: LiveEvent) -> bytes:
     """The MIDI bytes of an event (the inverse of :func:`decode`)."""
-    if isinstance(event, NoteOn):
-        return bytes((0x90 | event.channel, event.note, event.velocity))
-    if isinstance(event, NoteOff):
-        return bytes((0x80 | event.channel, event.note, event.velocity))
-    if isinstance(event, ControlChange):
-        return bytes((0xB0 | event.channel, event.control, event.value))
-    return bytes((0xC0 | event.channel, event.program))
+    data = midi_bytes(event)
+    assert data is not None  # every LiveEvent is a channel event
+    return data
 
 
 def upper_drum_note(note: int) -> int | None:

@@ -389,3 +389,20 @@ def format_bvh(bvh: Bvh, decimals: int = 4) -> str:
 def write_bvh(bvh: Bvh, path: str | Path, decimals: int = 4) -> None:
     """Write ``bvh`` to ``path`` (see :func:`format_bvh`)."""
     Path(path).write_text(format_bvh(bvh, decimals), encoding="utf-8")
+
+
+def world_pose(bvh: Bvh) -> tuple[np.ndarray, np.ndarray]:
+    """Forward kinematics of every frame: world positions (n, J, 3) in the file's units
+    and world rotations (n, J, 4, w x y z).  Joints are listed parents first."""
+    n, n_j = bvh.rotations.shape[:2]
+    wrot = np.empty_like(bvh.rotations)
+    wpos = np.empty((n, n_j, 3))
+    for j, joint in enumerate(bvh.joints):
+        p = joint.parent
+        if p < 0:
+            wrot[:, j] = bvh.rotations[:, j]
+            wpos[:, j] = bvh.positions[:, j]
+        else:
+            wrot[:, j] = quat.multiply(wrot[:, p], bvh.rotations[:, j])
+            wpos[:, j] = wpos[:, p] + quat.rotate(wrot[:, p], bvh.positions[:, j])
+    return wpos, wrot

@@ -16,7 +16,16 @@ import struct
 from dataclasses import dataclass, replace
 from enum import IntFlag
 
-from virja.events import Beat, Chord, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.events import (
+    Beat,
+    Chord,
+    ControlChange,
+    Event,
+    NoteOff,
+    NoteOn,
+    ProgramChange,
+    midi_bytes,
+)
 from virja.rmcp.bodies import (
     BeatBody,
     Body,
@@ -293,12 +302,4 @@ def to_events(dgram: Datagram, *, time_s: float | None = None) -> list[Event]:
 
 def event_message(event: Event) -> bytes | None:
     """The MIDI bytes of a channel event (None for Beat and Chord)."""
-    if isinstance(event, NoteOn):
-        return bytes((0x90 | event.channel, event.note, event.velocity))
-    if isinstance(event, NoteOff):
-        return bytes((0x80 | event.channel, event.note, event.velocity))
-    if isinstance(event, ControlChange):
-        return bytes((0xB0 | event.channel, event.control, event.value))
-    if isinstance(event, ProgramChange):
-        return bytes((0xC0 | event.channel, event.program))
-    return None
+    return midi_bytes(event)

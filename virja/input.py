@@ -8,6 +8,7 @@ tempo, the events to sound in the audio track, and a report for the CLI.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,6 +46,17 @@ class PerformanceInput:
         last_event = max(r.event.time_s for r in self.schedule)
         start = min(first, min(r.event.time_s for r in self.schedule))
         return (start, last_event + TAIL_S)
+
+
+def _band_notes(events: Iterable[Event], router: Router) -> int:
+    """How many note-ons the band plays.  Every event goes through the router, so
+    program changes take effect for the notes after them."""
+    n = 0
+    for ev in events:
+        who = router.route(ev)
+        if who is not None and isinstance(ev, NoteOn):
+            n += 1
+    return n
 
 
 def input_kind(path: Path) -> str:
@@ -87,7 +99,7 @@ def load_performance_input(
 def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> PerformanceInput:
     session = read_midi(path)
     dry = Router.for_session(session, routing)
-    notes = sum(1 for e in session.events if isinstance(e, NoteOn) and dry.route(e) is not None)
+    notes = _band_notes(session.events, dry)
     events: list[Event] = [*session.events, *session.beats]
     events.sort(key=lambda e: e.time_s)
     report = [f"{path}: {len(session.tracks)} tracks, {session.duration_s:.1f} s", *dry.report()]
@@ -121,9 +133,7 @@ def pcap_input(
         for rec in receiver.drain_events():
             schedule.append(Reveal(rec.arrival_s, rec.event))
     dry = Router(routing)
-    notes = sum(
-        1 for r in schedule if isinstance(r.event, NoteOn) and dry.route(r.event) is not None
-    )
+    notes = _band_notes((r.event for r in schedule), dry)
     sound = sorted(
         (r.event for r in schedule if isinstance(r.event, NoteOn | NoteOff)), key=lambda e: e.time_s
     )

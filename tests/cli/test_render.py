@@ -197,3 +197,24 @@ def test_audio_onset_lines_up_with_the_note_in_the_video(tmp_path: Path) -> None
         rate = w.getframerate()
     onset = int(np.argmax(np.abs(pcm) > 0.05 * np.abs(pcm).max())) / rate
     assert abs(onset - 1.5) < 0.04, onset  # the soundfont's snare attack takes ~25 ms
+
+
+def test_a_bass_known_only_by_its_program_is_rendered(tmp_path: Path) -> None:
+    """Regression: the render's routing report skipped program changes, so a bass part
+    on an unnamed track (GM program 32 only) was reported as nobody's and refused."""
+    mid = save_midi(
+        tmp_path / "p.mid",
+        [
+            [
+                M("program_change", channel=2, program=32, time=0),
+                M("note_on", channel=2, note=40, velocity=90, time=0),
+                M("note_off", channel=2, note=40, time=480),
+            ]
+        ],
+    )
+    assert (
+        main(
+            ["render", str(mid), "--out", str(tmp_path / "p.png"), "--at", "0.0", "--size", "32x32"]
+        )
+        == 0
+    )

@@ -215,7 +215,11 @@ class BandAnimator:
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
         elif p.performer == "bass":
             if p.string not in BASS_STRINGS:
-                raise UnknownMotionError(f"bass note without a known string: {p.string!r}")
+                raise UnknownMotionError(
+                    f"the bassist's clips cover the strings {' '.join(BASS_STRINGS)}; a note "
+                    f"planned on the {p.string!r} string (a five-string or custom tuning in "
+                    "[plan]) can be planned with `virja plan` but not animated yet"
+                )
             pluck = self.library[f"pluck_{p.string}"]
             self.timelines[("bass", "right_hand")].add(
                 Instance(

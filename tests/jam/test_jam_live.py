@@ -99,23 +99,29 @@ def test_negative_delay_is_refused() -> None:
         KeyboardJam(KeyboardLayout(), delay_s=-0.1)
 
 
-def test_rmcp_stream_announces_a_bass_program_before_the_first_bass_note() -> None:
-    stream = RmcpStream("127.0.0.1", 9, sender=7)
+def test_rmcp_stream_puts_a_bass_program_before_every_bass_note() -> None:
+    """Each bass note-on carries its channel's program in the same datagram, so a
+    receiver that joined late or lost a datagram still routes it to the bassist."""
+    stream = RmcpStream("127.0.0.1", 9, sender=7, seq_start=1000)
     try:
         first = stream.datagrams(Routed("bass", NoteOn(T, 0, 40, 100)))
         second = stream.datagrams(Routed("bass", NoteOff(T + 0.5, 0, 40, 0)))
+        again = stream.datagrams(Routed("bass", NoteOn(T + 0.75, 0, 43, 90)))
         drums = stream.datagrams(Routed("drums", NoteOn(T + 1, 9, 38, 90)))
     finally:
         stream.close()
-    parsed = [wire.Datagram.parse(d) for d in first + second + drums]
-    assert [p.seq for p in parsed] == [0, 1, 2, 3]
+    parsed = [wire.Datagram.parse(d) for d in first + second + again + drums]
+    assert [p.seq for p in parsed] == [1000, 1001, 1002, 1003]
     assert all(p.sender == 7 for p in parsed)
     assert parsed[0].time_us == wire.s_to_us(T)
-    events = [wire.to_events(p)[0] for p in parsed]
-    assert events[0] == ProgramChange(T, 0, RMCP_BASS_PROGRAM, 7)
-    assert events[1] == NoteOn(T, 0, 40, 100, 7)
-    assert events[2] == NoteOff(T + 0.5, 0, 40, 0, 7)
-    assert events[3] == NoteOn(T + 1, 9, 38, 90, 7)
+    events = [wire.to_events(p) for p in parsed]
+    assert events[0] == [ProgramChange(T, 0, RMCP_BASS_PROGRAM, 7), NoteOn(T, 0, 40, 100, 7)]
+    assert events[1] == [NoteOff(T + 0.5, 0, 40, 0, 7)]
+    assert events[2] == [
+        ProgramChange(T + 0.75, 0, RMCP_BASS_PROGRAM, 7),
+        NoteOn(T + 0.75, 0, 43, 90, 7),
+    ]
+    assert events[3] == [NoteOn(T + 1, 9, 38, 90, 7)]
 
 
 def test_rmcp_stream_sends_datagrams_over_loopback_udp() -> None:

@@ -7,7 +7,7 @@ import asyncio
 from virja.clock import SessionClock
 from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramChange
 from virja.rmcp.bodies import BeatBody, MidiBody
-from virja.rmcp.receiver import Received, Receiver
+from virja.rmcp.receiver import Received, Receiver, ReceiverConfig
 from virja.rmcp.sender import SendOptions, beats_of, schedule_pass
 from virja.rmcp.streamer import stream
 from virja.rmcp.transport import RmcpProtocol, open_listener, parse_hostport
@@ -184,3 +184,45 @@ def test_loopback_clock_client_gets_reply_from_a_listener() -> None:
         return len(client.estimator)
 
     assert asyncio.run(main()) >= 1
+
+
+def test_programs_are_repeated_at_each_bar_head() -> None:
+    """A receiver that missed the first datagram still learns the bass channel's program."""
+    tempo = TempoMap([(0.0, 0.5)])
+    beats = beats_of(tempo, 4.0, 4)  # two bars
+    items, _ = schedule_pass(EVENTS, tempo, beats, SendOptions(), START, route=route)
+    programs = [
+        s.datagram.time_us
+        for s in items
+        if s.datagram.sender == 1
+        and isinstance(s.datagram.body, MidiBody)
+        and bytes([0xC1, 33]) in s.datagram.body.messages
+    ]
+    assert programs == [START, START + 2_000_000]  # the file's own, then bar 2's head
+
+
+def test_a_restarted_sender_is_not_taken_for_repeats_or_replays() -> None:
+    """Each run numbers from the clock (ms), so a running receiver, keyed or not,
+    accepts a second run of the same file from the same sender ids."""
+    from virja.rmcp.signing import sign
+
+    for key in (None, b"k" * 16):
+        rx = Receiver(ReceiverConfig(key=key))
+        runs = []
+        for run, start_us in enumerate((START, START + 5_000_000)):
+            items, _ = schedule_pass(
+                EVENTS,
+                TempoMap(),
+                [],
+                SendOptions(),
+                start_us,
+                route=route,
+                seq_start=start_us // 1000,
+            )
+            runs.append(items)
+            for s in items:
+                d = sign(s.datagram, key) if key else s.datagram
+                rx.receive_datagram(bytes(d), ("127.0.0.1", 9), now_us=s.send_us)
+            assert rx.stats.dropped.get("duplicate", 0) == 0, (run, key)
+            assert not rx.stats.dropped, (run, key, rx.stats.dropped)
+        assert rx.stats.accepted == sum(len(r) for r in runs)

@@ -222,7 +222,7 @@ def run(args: argparse.Namespace) -> int:
         stream = None
         if send_to is not None:
             try:
-                stream = RmcpStream(*send_to)
+                stream = RmcpStream(*send_to, seq_start=clock.now_us() // 1000)
             except ValueError as exc:
                 raise ConfigError(f"--send {opts.send}: {exc}") from exc
             stack.callback(stream.close)

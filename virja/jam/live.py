@@ -25,7 +25,7 @@ import socket
 from dataclasses import dataclass
 from typing import Protocol
 
-from virja.events import Performer, ProgramChange
+from virja.events import NoteOn, Performer, ProgramChange
 from virja.jam.keyboard import KeyboardLayout, Routed, decode, encode, route
 from virja.rmcp import wire
 
@@ -122,17 +122,19 @@ RMCP_BASS_PROGRAM = 32
 class RmcpStream:
     """Routed events as RMCP/1 MIDI datagrams to ``(host, port)`` over UDP.
 
-    Each datagram's ``time`` is the event's time (arrival + delay).  Before the
-    first bass note on a channel it sends a program change to an acoustic bass,
-    so the receiver's router gives that channel to the bassist; drums go on
-    channel 10 and need nothing.  Not thread-safe beyond the GIL: one caller
-    (the MIDI thread) sends.
+    Each datagram's ``time`` is the event's time (arrival + delay).  Every bass
+    note-on carries, in the same datagram, a program change to an acoustic bass
+    before it, so the receiver's router gives that channel to the bassist even
+    if it joined late or lost a datagram; drums go on channel 10 and need
+    nothing.  Sequence numbers start at ``seq_start`` (the CLI passes the clock
+    in milliseconds, so a restarted jam keeps numbering upwards).  Not
+    thread-safe beyond the GIL: one caller (the MIDI thread) sends.
     """
 
-    def __init__(self, host: str, port: int, *, sender: int = 1) -> None:
+    def __init__(self, host: str, port: int, *, sender: int = 1, seq_start: int = 0) -> None:
         self.sender = sender
         self.addr = (host, port)
-        self._seq = 0
+        self._seq = seq_start & 0xFFFF_FFFF
         self._bass_channels: set[int] = set()
         try:
             info = socket.getaddrinfo(host, port, type=socket.SOCK_DGRAM)[0]
@@ -148,15 +150,16 @@ class RmcpStream:
         ev = routed.event
         t_us = wire.s_to_us(ev.time_s)
         perf: Performer | None = routed.performer
-        if perf == "bass" and ev.channel not in self._bass_channels:
+        if perf == "bass" and isinstance(ev, NoteOn):
             self._bass_channels.add(ev.channel)
             pc = ProgramChange(time_s=ev.time_s, channel=ev.channel, program=RMCP_BASS_PROGRAM)
-            out.append(self._next(t_us, encode(pc)))
-        out.append(self._next(t_us, encode(ev)))
+            out.append(self._next(t_us, encode(pc), encode(ev)))
+        else:
+            out.append(self._next(t_us, encode(ev)))
         return out
 
-    def _next(self, time_us: int, message: bytes) -> bytes:
-        dgram = wire.midi(self.sender, self._seq, time_us, message)
+    def _next(self, time_us: int, *messages: bytes) -> bytes:
+        dgram = wire.midi(self.sender, self._seq, time_us, *messages)
         self._seq = (self._seq + 1) & 0xFFFF_FFFF
         return bytes(dgram)
 

@@ -76,10 +76,14 @@ def schedule_pass(
     *,
     route: Route,
     seqs: dict[int, int] | None = None,
+    seq_start: int = 0,
 ) -> tuple[list[Scheduled], dict[int, int]]:
     """The datagrams of one pass starting at session time ``start_us``, by send time.
 
-    ``seqs`` is the next sequence number per sender id (updated copy returned).
+    ``seqs`` is the next sequence number per sender id (updated copy returned);
+    a sender not in it starts at ``seq_start``.  Each bar head also repeats the
+    program in force on every channel that had a program change, so a receiver
+    that joins late, or lost the first datagram, still knows the bass channel.
     """
     next_seq = dict(seqs or {})
     # (time_us, sender) -> messages, in event order
@@ -92,12 +96,15 @@ def schedule_pass(
     for ev, r in zip(events, routes, strict=True):
         if r is not None and isinstance(ev, NoteOn | NoteOff):
             channel_route.setdefault((ev.track, ev.channel), r)
+    programs: list[tuple[float, int, int, int]] = []  # (time, sender, channel, program)
     for ev, r in zip(events, routes, strict=True):
         msg = event_message(ev)
         if msg is None:
             continue
         if r is None and isinstance(ev, ControlChange | ProgramChange):
             r = channel_route.get((ev.track, ev.channel))
+        if isinstance(ev, ProgramChange):
+            programs.append((ev.time_s, options.sender_for(r), ev.channel, ev.program))
         key = (start_us + s_to_us(ev.time_s), options.sender_for(r))
         if key not in groups:
             groups[key] = []
@@ -116,10 +123,19 @@ def schedule_pass(
         beat = BeatBody(b.bar, b.beat, b.beats_per_bar, b.level, b.tempo_us)
         items.append((time_us - lead_us, time_us, n, options.conductor, beat))
         n += 1
+        if b.level == 2 and b.time_s > 0:  # bar head: repeat the programs in force
+            in_force: dict[tuple[int, int], int] = {}
+            for t, sender, channel, program in programs:
+                if t <= b.time_s:
+                    in_force[(sender, channel)] = program
+            for (sender, channel), program in sorted(in_force.items()):
+                repeat = MidiBody((bytes((0xC0 | channel, program)),))
+                items.append((time_us - lead_us, time_us, n, sender, repeat))
+                n += 1
     items.sort(key=lambda it: (it[0], it[1], it[2]))
     out: list[Scheduled] = []
     for send_us, time_us, _, sender, body in items:
-        seq = next_seq.get(sender, 0)
+        seq = next_seq.get(sender, seq_start & 0xFFFF_FFFF)
         next_seq[sender] = seq_add(seq, 1)
         out.append(Scheduled(send_us, Datagram(sender, seq, time_us, body)))
     return out, next_seq

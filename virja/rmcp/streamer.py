@@ -94,6 +94,10 @@ async def stream(
         start_us = clock.now_us() + round(start_in_s * 1_000_000)
         period_us = max(1, round(duration_s * 1_000_000))
         seqs: dict[int, int] = {}
+        # Sequence numbers start from the clock (milliseconds, modulo 2^32), so a
+        # restarted sender keeps numbering upwards: its datagrams are neither taken
+        # for repeats (last 4096) nor, with a key, for replays (at or below the last).
+        seq_start = (clock.now_us() // 1000) & 0xFFFFFFFF
         n = 0
         while max_passes is None or n < max_passes:
             items, seqs = schedule_pass(
@@ -104,6 +108,7 @@ async def stream(
                 start_us + n * period_us,
                 route=route_factory(),
                 seqs=seqs,
+                seq_start=seq_start,
             )
             for item in items:
                 wait_us = item.send_us - clock.now_us()

@@ -1,10 +1,13 @@
 """The configuration file: one TOML document, one table per layer.
 
 ```toml
-[routing]      # virja.routing.RoutingConfig
-[plan]         # virja.plan (tunings, tables)
-[render]       # size, fps, camera
+[routing]      # virja.routing.RoutingConfig (docs/routing.md)
+[plan]         # virja.plan.config: tunings, frets, replacement tables (docs/scheduler.md)
+[jam]          # virja.jam.options: split, upper keys, delay, ports (docs/jam.md)
 ```
+
+Any other table is refused (a misspelt one must not be ignored in silence);
+rendering options are command-line flags only.
 
 This module only reads and checks the document's shape; each layer parses its
 own table, so a layer's options live beside the code that uses them.
@@ -18,7 +21,7 @@ from typing import Any
 
 from virja.errors import ConfigError, InputFileError
 
-KNOWN_TABLES = frozenset({"routing", "plan", "render", "serve", "jam", "motion"})
+KNOWN_TABLES = frozenset({"routing", "plan", "jam"})
 
 
 def load_config(path: str | Path | None) -> dict[str, Any]:

@@ -104,7 +104,8 @@ def _open(path: Path) -> mido.MidiFile:
     try:
         return mido.MidiFile(str(path), clip=False)
     except (OSError, EOFError, ValueError, KeyError, IndexError, TypeError) as exc:
-        raise InputFileError(path, f"not a readable MIDI file: {exc}") from exc
+        why = str(exc) or type(exc).__name__
+        raise InputFileError(path, f"not a readable MIDI file: {why}") from exc
 
 
 def read_midi(path: str | Path) -> MidiSession:

@@ -46,25 +46,32 @@ class RoutingConfig:
     tracks: Mapping[str, Route] = field(default_factory=dict)  # lower-case name -> route
 
     @classmethod
-    def from_dict(cls, table: Mapping[str, Any]) -> RoutingConfig:
-        """From the ``[routing]`` table of the config file."""
+    def from_dict(cls, table: Mapping[str, Any], where: str = "[routing]") -> RoutingConfig:
+        """From the ``[routing]`` table of the config file; ``where`` names it in errors."""
         known = {"drum_channels", "bass_programs", "bass_track_words", "channels", "tracks"}
         unknown = set(table) - known
         if unknown:
-            raise ConfigError(f"[routing]: unknown key(s) {', '.join(sorted(unknown))}")
+            raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
         base = cls()
-        drum = frozenset(_channel_list(table.get("drum_channels", sorted(base.drum_channels))))
-        progs = table.get("bass_programs", sorted(base.bass_programs))
-        if not all(isinstance(p, int) and 0 <= p <= 127 for p in progs):
-            raise ConfigError("[routing] bass_programs: integers 0-127 (GM programs, 0-based)")
-        words = tuple(str(w).lower() for w in table.get("bass_track_words", base.bass_track_words))
+        drum = frozenset(
+            _channel_list(_list_of(table, "drum_channels", sorted(base.drum_channels), where))
+        )
+        progs = _list_of(table, "bass_programs", sorted(base.bass_programs), where)
+        if not all(isinstance(p, int) and not isinstance(p, bool) and 0 <= p <= 127 for p in progs):
+            raise ConfigError(f"{where} bass_programs: integers 0-127 (GM programs, 0-based)")
+        words_raw = _list_of(table, "bass_track_words", list(base.bass_track_words), where)
+        if not all(isinstance(w, str) for w in words_raw):
+            raise ConfigError(f"{where} bass_track_words: a list of strings")
+        words = tuple(w.lower() for w in words_raw)
         chans: dict[int, Route] = {}
-        for k, v in dict(table.get("channels", {})).items():
-            (ch,) = _channel_list([int(k)] if str(k).isdigit() else [k])
-            chans[ch] = _target(v, f"[routing.channels] {k}")
+        for k, v in _table_of(table, "channels", where).items():
+            if not str(k).isascii() or not str(k).isdigit():
+                raise ConfigError(f"{where}.channels: key {k!r} must be a channel number 1-16")
+            (ch,) = _channel_list([int(k)])
+            chans[ch] = _target(v, f"{where}.channels {k}")
         tracks = {
-            str(k).lower(): _target(v, f"[routing.tracks] {k!r}")
-            for k, v in dict(table.get("tracks", {})).items()
+            str(k).lower(): _target(v, f"{where}.tracks {k!r}")
+            for k, v in _table_of(table, "tracks", where).items()
         }
         return cls(drum, frozenset(progs), words, chans, tracks)
 
@@ -90,10 +97,24 @@ class RoutingConfig:
         )
 
 
+def _list_of(table: Mapping[str, Any], key: str, default: list[Any], where: str) -> list[Any]:
+    value = table.get(key, default)
+    if not isinstance(value, list):
+        raise ConfigError(f"{where} {key}: must be a list, got {type(value).__name__} {value!r}")
+    return value
+
+
+def _table_of(table: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
+    value = table.get(key, {})
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{where} {key}: must be a table, got {type(value).__name__} {value!r}")
+    return value
+
+
 def _channel_list(values: Iterable[Any]) -> list[int]:
     out = []
     for v in values:
-        if not isinstance(v, int) or not 1 <= v <= 16:
+        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 16:
             raise ConfigError(f"MIDI channel must be 1-16, got {v!r}")
         out.append(v)
     return out

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from virja.cli.common import finite_float
 from virja.dance.audio import read_audio_8k
 from virja.dance.beats import BeatParams, extract_beats
 
@@ -21,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--k",
-        type=float,
+        type=finite_float,
         default=BeatParams().k_mad,
         help="threshold: median + K robust deviations (default 4)",
     )

@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from virja.cli.common import finite_float
 from virja.dance.audio import read_audio_8k
 from virja.dance.database import load_database
 from virja.dance.generate import generate
@@ -36,7 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="also draw the dancer: a video (.mp4/.mkv/.mov, MUSIC as sound), a folder or NAME.png",
     )
     parser.add_argument("--size", default="640x360", metavar="WxH", help="frame size (640x360)")
-    parser.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    parser.add_argument(
+        "--fps", type=finite_float, default=30.0, help="frames per second (default 30)"
+    )
     parser.add_argument("--camera", default="front", help="camera preset (default front)")
 
 

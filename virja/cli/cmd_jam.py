@@ -26,6 +26,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
+from virja.cli.common import finite_float
 from virja.config import section
 from virja.errors import ConfigError, InputFileError
 
@@ -65,7 +66,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--delay-ms",
-        type=float,
+        type=finite_float,
         default=None,
         metavar="D",
         help="delay picture and thru sound by D ms so motions keep their anticipation (default 0)",
@@ -84,7 +85,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--plan-log", default=None, metavar="FILE.jsonl", help="write planned notes"
     )
     parser.add_argument(
-        "--duration", type=float, default=None, metavar="SECONDS", help="stop after this long"
+        "--duration",
+        type=finite_float,
+        default=None,
+        metavar="SECONDS",
+        help="stop after this long",
     )
     parser.add_argument("--config", default=None, metavar="FILE.toml", help="configuration file")
 
@@ -173,7 +178,8 @@ def build_performance(
     from virja.routing import Router, RoutingConfig
     from virja.session import Performance
 
-    router = Router(RoutingConfig.from_dict(section(doc, "routing")))
+    where = f"{config_path} [routing]" if config_path else "[routing]"
+    router = Router(RoutingConfig.from_dict(section(doc, "routing"), where))
     animator = None
     if animate:
         from virja.motion.band import BandAnimator

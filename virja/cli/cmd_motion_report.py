@@ -19,27 +19,28 @@ import argparse
 import time
 from pathlib import Path
 
-from virja.errors import InputFileError
+from virja.cli.common import finite_float
+from virja.errors import ConfigError, InputFileError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", help="MIDI file (type 0/1)")
     parser.add_argument(
         "--lookahead-beats",
-        type=float,
+        type=finite_float,
         default=1.0,
         metavar="B",
         help="each note is known B beats before it sounds (default 1)",
     )
     parser.add_argument(
         "--max-seconds",
-        type=float,
+        type=finite_float,
         default=60.0,
         metavar="S",
         help="measure only the first S seconds of the file (default 60)",
     )
     parser.add_argument(
-        "--fps", type=float, default=120.0, help="sampling rate for continuity (default 120)"
+        "--fps", type=finite_float, default=120.0, help="sampling rate for continuity (default 120)"
     )
     parser.add_argument("--per-note", action="store_true", help="also print one line per note")
 
@@ -53,6 +54,10 @@ def run(args: argparse.Namespace) -> int:
     from virja.routing import Router, route_all
 
     path = Path(args.input)
+    if not 1 <= args.fps <= 1000:
+        raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
+    if args.max_seconds <= 0:
+        raise ConfigError(f"--max-seconds must be > 0, got {args.max_seconds:g}")
     if not path.is_file():
         raise InputFileError(path, "no such file")
     session = read_midi(path)

@@ -19,6 +19,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from virja.cli.common import finite_float
 from virja.errors import ConfigError
 from virja.events import NoteOn
 from virja.plan.types import PlannedNote, PlanReport
@@ -31,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="one JSON object per planned note")
     parser.add_argument(
         "--lookahead-beats",
-        type=float,
+        type=finite_float,
         default=1.0,
         metavar="B",
         help="MIDI files: each note is known B beats before it sounds (default 1)",
@@ -51,7 +52,12 @@ def _plan_midi(
     from virja.routing import Router, RoutingConfig, route_all
 
     session = read_midi(path)
-    router = Router.for_session(session, RoutingConfig.from_dict(section(doc, "routing")))
+    router = Router.for_session(
+        session,
+        RoutingConfig.from_dict(
+            section(doc, "routing"), f"{args.config} [routing]" if args.config else "[routing]"
+        ),
+    )
     notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
     return plan_notes_with_report(
         notes,
@@ -71,7 +77,9 @@ def _plan_pcap(
     from virja.routing import Router, RoutingConfig
     from virja.session import Performance, run_schedule
 
-    routing = RoutingConfig.from_dict(section(doc, "routing"))
+    routing = RoutingConfig.from_dict(
+        section(doc, "routing"), f"{args.config} [routing]" if args.config else "[routing]"
+    )
     src = pcap_input(path, routing, port=args.port)
     planner = OnlinePlanner(load_plan_config(args.config))
     perf = Performance(router=Router(routing), planner=planner)

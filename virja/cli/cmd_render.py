@@ -21,8 +21,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from virja.cli.common import (
+    SAMPLE_CHOICES,
     ProgressBar,
     add_routing_arguments,
+    finite_float,
     make_router,
     open_plan_log,
     routing_config,
@@ -47,13 +49,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--size", default="1280x720", metavar="WxH", help="frame size (default 1280x720)"
     )
-    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--fps", type=finite_float, default=30.0, help="frames per second (default 30)")
     p.add_argument(
         "--camera", choices=sorted(PRESETS), default="front", help="camera preset (default front)"
     )
     p.add_argument(
         "--lookahead-beats",
-        type=float,
+        type=finite_float,
         default=1.0,
         metavar="B",
         help="notes are known B beats ahead (default 1)",
@@ -64,23 +66,27 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--at",
-        type=float,
+        type=finite_float,
         metavar="SECONDS",
         help="render only the frame at this time (with a .png OUT)",
     )
     p.add_argument(
         "--start",
-        type=float,
+        type=finite_float,
         metavar="SECONDS",
         help="first frame time (default: early enough for the first motion)",
     )
     p.add_argument(
-        "--end", type=float, metavar="SECONDS", help="last frame time (default: the end plus 1.5 s)"
+        "--end",
+        type=finite_float,
+        metavar="SECONDS",
+        help="last frame time (default: the end plus 1.5 s)",
     )
     p.add_argument(
         "--samples",
         type=int,
         default=1,
+        choices=SAMPLE_CHOICES,
         help="multisample anti-aliasing, 1 (off, default) to 8; 4 looks smoother and renders about 2.5x slower here",
     )
     p.add_argument(
@@ -196,7 +202,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
     rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
     where = out.path if out.kind != "png" or len(result.outputs) != 1 else result.outputs[0]
     print(
-        f"wrote {result.frames} frames ({t0:.2f} s to {t1:.2f} s at {args.fps:g} fps) to {where} "
+        f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} ({t0:.2f} s to {t1:.2f} s at {args.fps:g} fps) to {where} "
         f"in {result.seconds:.1f} s ({rate:.1f} frames/s); "
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )

@@ -20,7 +20,13 @@ import math
 import time
 from pathlib import Path
 
-from virja.cli.common import add_routing_arguments, make_router, open_plan_log
+from virja.cli.common import (
+    SAMPLE_CHOICES,
+    add_routing_arguments,
+    finite_float,
+    make_router,
+    open_plan_log,
+)
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
 
@@ -39,11 +45,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--out", metavar="OUT", help="render to a video (.mp4/.mkv/.mov), a folder or NAME.png"
     )
     p.add_argument("--size", default="1280x720", metavar="WxH")
-    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--fps", type=finite_float, default=30.0)
     p.add_argument("--camera", choices=sorted(PRESETS), default="front")
     p.add_argument("--no-audio", action="store_true")
     p.add_argument("--soundfont", metavar="FILE.sf2")
-    p.add_argument("--samples", type=int, default=1, help="multisampling (default 1 = off)")
+    p.add_argument(
+        "--samples",
+        type=int,
+        default=1,
+        choices=SAMPLE_CHOICES,
+        help="multisampling (default 1 = off)",
+    )
     from virja.cli.cmd_render import add_dancer_argument
 
     add_dancer_argument(p)

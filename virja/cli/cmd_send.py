@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 
+from virja.cli.common import finite_float
 from virja.errors import ConfigError
 
 
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--lead-beats",
-        type=float,
+        type=finite_float,
         default=1.0,
         metavar="B",
         help="send each note B beats before it sounds (default 1)",
@@ -47,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--start-in",
-        type=float,
+        type=finite_float,
         default=1.0,
         metavar="SECONDS",
         help="the file starts this long after launch (default 1)",
@@ -70,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
     if args.sender is not None and not 0 <= args.sender <= 65535:
         raise ConfigError("--sender must be 0-65535")
     host, port = parse_hostport(args.to)
+    if port == 0:
+        raise ConfigError(f"--to {args.to}: port 0 is not a destination")
     bind = parse_hostport(args.bind) if args.bind else None
     key = load_key(args.key_file) if args.key_file else None
     session = read_midi(args.file)

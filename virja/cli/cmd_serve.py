@@ -24,7 +24,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from virja.cli.common import add_routing_arguments, make_router, open_plan_log
+from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
 from virja.config import load_config
 from virja.errors import ConfigError
 
@@ -65,18 +65,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="estimate the session clock offset from this peer",
     )
     p.add_argument(
-        "--duration", type=float, metavar="SECONDS", help="stop by itself after this long (exit 0)"
+        "--duration",
+        type=finite_float,
+        metavar="SECONDS",
+        help="stop by itself after this long (exit 0)",
     )
     p.add_argument(
         "--horizon",
-        type=float,
+        type=finite_float,
         default=10.0,
         metavar="SECONDS",
         help="drop events further ahead (default 10)",
     )
     p.add_argument(
         "--lateness-ms",
-        type=float,
+        type=finite_float,
         default=60.0,
         metavar="MS",
         help="still play notes this late (default 60)",
@@ -123,8 +126,9 @@ class Daemon:
         drops = sum(st.dropped.values())
         c = self.perf.counts
         line = (
-            f"{st.datagrams} datagrams, {c['planned']} notes planned "
-            f"({c['notes_bass']} bass, {c['notes_drums']} drums), {drops} dropped, {self.late_notes} late"
+            f"{st.datagrams} datagrams ({drops} dropped), band notes received: "
+            f"{c['notes_bass']} bass, {c['notes_drums']} drums ({self.late_notes} late); "
+            f"{c['planned']} motions started"
         )
         if self.clock_client is not None:
             est = self.clock_client.estimator.estimate()
@@ -163,6 +167,25 @@ def run(args: argparse.Namespace) -> int:
     return asyncio.run(serve(args))
 
 
+def _resolve_or_fail(addr: tuple[str, int], option: str) -> None:
+    import socket
+
+    try:
+        socket.getaddrinfo(addr[0], addr[1], type=socket.SOCK_DGRAM)
+    except (OSError, UnicodeError) as exc:
+        raise ConfigError(
+            f"{option} {addr[0]}:{addr[1]}: cannot resolve: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
+
+
+def _report_clock_failure(task: asyncio.Task[Any]) -> None:
+    if task.cancelled():
+        return
+    exc = task.exception()
+    if exc is not None:
+        print(f"virja serve: the clock client stopped: {exc}", file=sys.stderr, flush=True)
+
+
 async def serve(args: argparse.Namespace) -> int:
     from virja.clock import SessionClock
     from virja.motion.band import BandAnimator
@@ -186,29 +209,41 @@ async def serve(args: argparse.Namespace) -> int:
     receiver = Receiver(
         ReceiverConfig(horizon_s=args.horizon, lateness_s=args.lateness_ms / 1000, key=key)
     )
-    plan_log = open_plan_log(args.plan_log)
+    clock_server = parse_hostport(args.clock_server) if args.clock_server else None
+    if clock_server is not None:
+        _resolve_or_fail(clock_server, "--clock-server")
+    # bind first: a port in use must not cost the user an existing plan log or recording
     perf = Performance(
         router=make_router(args),
         planner=OnlinePlanner(load_plan_config(args.config)),
         animator=BandAnimator(),
-        plan_log=plan_log,
     )
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
-    view = None
-    if not args.headless:
-        from virja.render.live import LiveView
-
-        view = LiveView(parse_size(args.size), title=f"virja serve {host}:{port}")
     daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_listener(host, port, protocol, group=args.group)
     bound = transport.get_extra_info("sockname")
-    if args.record:
-        # the recording names the address and port actually bound (port 0 picks one)
-        wildcard = bound[0] in ("0.0.0.0", "::")
-        local_host = ("::1" if ":" in bound[0] else "127.0.0.1") if wildcard else bound[0]
-        recorder = PcapWriter.open(args.record, local=(local_host, bound[1]))
-        protocol.recorder = daemon.recorder = recorder
+    view = None
+    try:
+        if not args.headless:
+            from virja.render.live import LiveView
+
+            view = LiveView(parse_size(args.size), title=f"virja serve {host}:{port}")
+        perf.plan_log = open_plan_log(args.plan_log)
+        if args.record:
+            # the recording names the address and port actually bound (port 0 picks one)
+            wildcard = bound[0] in ("0.0.0.0", "::")
+            local_host = ("::1" if ":" in bound[0] else "127.0.0.1") if wildcard else bound[0]
+            recorder = PcapWriter.open(args.record, local=(local_host, bound[1]))
+            protocol.recorder = daemon.recorder = recorder
+    except BaseException:
+        transport.close()
+        if view is not None:
+            view.close()
+        if perf.plan_log is not None:
+            perf.plan_log.close()
+        raise
+    plan_log = perf.plan_log
     print(
         f"virja serve: listening on {bound[0]}:{bound[1]}"
         + (f", group {args.group}" if args.group else ""),
@@ -221,9 +256,11 @@ async def serve(args: argparse.Namespace) -> int:
         with contextlib.suppress(NotImplementedError, RuntimeError):
             loop.add_signal_handler(sig, stop.set)
     tasks: list[asyncio.Task[Any]] = []
-    if args.clock_server:
-        daemon.clock_client = ClockClient(parse_hostport(args.clock_server), clock, key=key)
-        tasks.append(asyncio.create_task(daemon.clock_client.run()))
+    if clock_server is not None:
+        daemon.clock_client = ClockClient(clock_server, clock, key=key)
+        clock_task = asyncio.create_task(daemon.clock_client.run())
+        clock_task.add_done_callback(_report_clock_failure)
+        tasks.append(clock_task)
     if args.duration is not None:
         loop.call_later(args.duration, stop.set)
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from virja.cli.common import finite_float
 from virja.dance.audio import read_audio_8k
 from virja.dance.database import DanceError, load_database, merge, save_database, teach
 from virja.dance.segment import DEFAULT_TOLERANCE_FRAMES, PARTS
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, metavar="DB", help="database folder to write")
     parser.add_argument(
         "--tolerance",
-        type=float,
+        type=finite_float,
         default=DEFAULT_TOLERANCE_FRAMES,
         metavar="FRAMES",
         help="how far a beat may be from a minimum of acceleration (default 3 frames)",

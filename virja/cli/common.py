@@ -3,12 +3,27 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import IO, Any
 
 from virja.config import load_config, section
 from virja.routing import Router, RoutingConfig
+
+
+def finite_float(text: str) -> float:
+    """An argparse type: a finite number ("nan" and "inf" are refused, with a one-line error)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+SAMPLE_CHOICES = (1, 2, 4, 8)
 
 
 def add_routing_arguments(p: argparse.ArgumentParser) -> None:
@@ -50,7 +65,8 @@ def add_routing_arguments(p: argparse.ArgumentParser) -> None:
 
 def routing_config(args: argparse.Namespace, doc: dict[str, Any] | None = None) -> RoutingConfig:
     doc = load_config(args.config) if doc is None else doc
-    base = RoutingConfig.from_dict(section(doc, "routing"))
+    where = f"{args.config} [routing]" if getattr(args, "config", None) else "[routing]"
+    base = RoutingConfig.from_dict(section(doc, "routing"), where)
     return base.with_overrides(
         bass_channels=args.bass_channel,
         drum_channels=args.drums_channel,

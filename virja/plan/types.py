@@ -62,8 +62,12 @@ class PlannedNote:
     late: bool
 
     def to_json(self) -> dict[str, Any]:
-        """A dict with exactly :data:`JSON_KEYS`, in that order."""
-        return {key: getattr(self, key) for key in JSON_KEYS}
+        """A dict with exactly :data:`JSON_KEYS`, in that order; times rounded to the
+        microsecond (the wire's resolution), so logs carry no float noise."""
+        out = {key: getattr(self, key) for key in JSON_KEYS}
+        for key in ("time", "start", "impact"):
+            out[key] = round(out[key], 6)
+        return out
 
     @classmethod
     def from_json(cls, data: dict[str, Any]) -> PlannedNote:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -105,16 +106,20 @@ def render_frames(
     target = OffscreenTarget(ctx, size, samples=samples)
     writer: VideoWriter | None = None
     outputs: list[Path] = []
+    folder = out.path if out.kind == "folder" else out.path.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(
+            f"--out {out.path}: cannot make {folder}: {exc.strerror or exc}"
+        ) from None
+    if not os.access(folder, os.W_OK):
+        raise ConfigError(f"--out {out.path}: the folder {folder} is not writable")
     if out.kind == "video":
-        out.path.parent.mkdir(parents=True, exist_ok=True)
         writer = VideoWriter(
             out.path, size, fps, audio=audio, audio_offset_s=audio_offset_s, bottom_up=True
         )
         outputs.append(out.path)
-    elif out.kind == "folder":
-        out.path.mkdir(parents=True, exist_ok=True)
-    else:
-        out.path.parent.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     try:
         for i, t in enumerate(times):

@@ -152,6 +152,7 @@ class VideoWriter:
             cmd += ["-map", "0:v:0", "-map", "1:a:0", "-shortest"]
         cmd += [str(path)]
         self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        self._err_text: str | None = None
         self.frames = 0
 
     def write_raw(self, data: bytes) -> None:
@@ -180,12 +181,20 @@ class VideoWriter:
         self.frames += 1
 
     def _stderr(self) -> str:
-        assert self._proc.stderr is not None
-        return self._proc.stderr.read().decode(errors="replace").strip()[:500]
+        """What ffmpeg said (read once, kept: a failed write and the close both report it)."""
+        if self._err_text is None:
+            assert self._proc.stderr is not None
+            text = self._proc.stderr.read().decode(errors="replace").strip()
+            # the last lines say why; keep them whole on one line
+            self._err_text = " / ".join(text.splitlines()[-3:])[:500]
+        return self._err_text
 
     def close(self) -> None:
         assert self._proc.stdin is not None
-        self._proc.stdin.close()
+        try:
+            self._proc.stdin.close()
+        except BrokenPipeError:
+            pass  # ffmpeg already stopped; its exit status and message say why
         rc = self._proc.wait()
         if rc != 0:
             raise NotAvailableError(f"ffmpeg failed ({rc}): {self._stderr()}")

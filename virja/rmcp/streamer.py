@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, cast
 
 from virja.clock import SessionClock
+from virja.errors import ConfigError
 from virja.events import Beat, Event
 from virja.rmcp.receiver import Receiver, ReceiverConfig
 from virja.rmcp.sender import Route, Scheduled, SendOptions, schedule_pass
@@ -82,7 +83,14 @@ async def stream(
     if family == socket.AF_INET:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_BROADCAST, 1)
     # the socket clock requests are answered on: --bind, else any address, a free port
-    sock.bind(bind if bind is not None else ("::" if family == socket.AF_INET6 else "0.0.0.0", 0))
+    try:
+        sock.bind(
+            bind if bind is not None else ("::" if family == socket.AF_INET6 else "0.0.0.0", 0)
+        )
+    except (OSError, OverflowError) as exc:
+        sock.close()
+        where = f"{bind[0]}:{bind[1]}" if bind is not None else "a local port"
+        raise ConfigError(f"cannot bind {where}: {getattr(exc, 'strerror', None) or exc}") from None
     if on_bound is not None:
         name = sock.getsockname()
         on_bound((str(name[0]), int(name[1])))

@@ -50,6 +50,14 @@ def parse_hostport(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, in
         port_s = rest[1:]
     elif t.count(":") == 1:
         host, port_s = t.split(":")
+    elif ":" in t:
+        try:
+            ipaddress.ip_address(t.split("%")[0])
+        except ValueError:
+            raise ConfigError(
+                f"bad address {text!r}: write an IPv6 address with a port as [ADDR]:PORT, "
+                "e.g. [::1]:50500"
+            ) from None
     if not host:
         raise ConfigError(f"bad address {text!r}: no host")
     if not port_s:
@@ -71,7 +79,12 @@ def _family(host: str) -> socket.AddressFamily:
             else socket.AF_INET
         )
     except ValueError:
-        infos = socket.getaddrinfo(host, None, type=socket.SOCK_DGRAM)
+        try:
+            infos = socket.getaddrinfo(host, None, type=socket.SOCK_DGRAM)
+        except (OSError, UnicodeError) as exc:
+            raise ConfigError(
+                f"cannot resolve {host!r}: {getattr(exc, 'strerror', None) or exc}"
+            ) from None
         if not infos:
             raise ConfigError(f"cannot resolve {host!r}") from None
         return infos[0][0]
@@ -79,6 +92,15 @@ def _family(host: str) -> socket.AddressFamily:
 
 def make_socket(host: str, port: int, *, group: str | None = None) -> socket.socket:
     """A bound, non-blocking UDP socket; joins ``group`` (IPv4 or IPv6 multicast) if given."""
+    if group is not None:
+        try:
+            is_multicast = ipaddress.ip_address(group.split("%")[0]).is_multicast
+        except ValueError:
+            is_multicast = False
+        if not is_multicast:
+            raise ConfigError(
+                f"--group {group}: not a multicast address (IPv4 224.0.0.0/4, IPv6 ff00::/8)"
+            )
     fam = _family(group or host)
     sock = socket.socket(fam, socket.SOCK_DGRAM)
     try:
@@ -227,7 +249,9 @@ class ClockClient:
         self._pending[nonce] = t0
         while len(self._pending) > 16:
             self._pending.pop(next(iter(self._pending)))
-        d = clock_request(self.sender_id, self._seq, nonce=nonce, t0_us=t0)
+        d = clock_request(
+            self.sender_id, self._seq, nonce=nonce, t0_us=t0, time_us=self.clock.now_us()
+        )
         self._seq = seq_add(self._seq, 1)
         return bytes(sign(d, self.key) if self.key is not None else d)
 

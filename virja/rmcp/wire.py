@@ -239,9 +239,14 @@ def chord(
     return Datagram(sender, seq, time_us, ChordBody(root, bass, quality))
 
 
-def clock_request(sender: int, seq: int, *, nonce: int, t0_us: int) -> Datagram:
-    """A CLOCK_REQUEST, IMMEDIATE, with ``time`` = t0 (the sender's current time)."""
-    return Datagram(sender, seq, t0_us, ClockRequestBody(nonce, t0_us), Flags.IMMEDIATE)
+def clock_request(
+    sender: int, seq: int, *, nonce: int, t0_us: int, time_us: int | None = None
+) -> Datagram:
+    """A CLOCK_REQUEST, IMMEDIATE.  ``t0_us`` (the body) is the requester's own clock;
+    the header's ``time`` is its current *session* time (``time_us``, default t0), as
+    the spec asks of IMMEDIATE datagrams, so a keyed receiver's 30 s rule holds."""
+    header_us = t0_us if time_us is None else time_us
+    return Datagram(sender, seq, header_us, ClockRequestBody(nonce, t0_us), Flags.IMMEDIATE)
 
 
 def clock_reply(

@@ -8,6 +8,7 @@ video is made silent and the caller is told why.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import shutil
@@ -191,10 +192,9 @@ class VideoWriter:
 
     def close(self) -> None:
         assert self._proc.stdin is not None
-        try:
+        # ffmpeg may already have stopped; its exit status and message say why
+        with contextlib.suppress(BrokenPipeError):
             self._proc.stdin.close()
-        except BrokenPipeError:
-            pass  # ffmpeg already stopped; its exit status and message say why
         rc = self._proc.wait()
         if rc != 0:
             raise NotAvailableError(f"ffmpeg failed ({rc}): {self._stderr()}")

@@ -408,7 +408,7 @@ class OnlinePlanner:
             if free(chain.name):
                 self._emit_stroke(chain, [rec], piece, chain.name, 0.0)
             else:
-                self._drop(rec, "too_late")
+                self._drop(rec, "no_free_limb")
             return
         costs = self.config.costs
         before = [(ft, p) for ft, p in chain.fixed if ft < t - GROUP_EPS_S]
@@ -421,7 +421,7 @@ class OnlinePlanner:
             if free(h)
         ]
         if not choices:
-            self._drop(rec, "too_late")
+            self._drop(rec, "no_free_limb")
             return
         cost, hand = min(choices)
         self._emit_stroke(chain, [rec], piece, hand, cost)

@@ -98,7 +98,7 @@ class PlannedNote:
 DropReason = Literal[
     "too_many_hands",  # more simultaneous hand pieces than hands (priority kept the others)
     "too_fast",  # the limb cannot strike again so soon (minimum inter-stroke time)
-    "too_late",  # arrived after later notes of its limb had been fixed, and no limb was free
+    "no_free_limb",  # came after later notes of its limbs were fixed, and no limb was free then
     "unmapped",  # a drum note outside the kit map
     "no_double_stop",  # a simultaneous bass note that cannot be stopped with the melody note
 ]

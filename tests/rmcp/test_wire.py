@@ -276,3 +276,19 @@ def test_load_key_errors_name_the_file(tmp_path: object) -> None:
     p.write_bytes(b"  \n")
     with pytest.raises(InputFileError, match=r"k: key file is empty"):
         load_key(p)
+
+
+def test_beat_reserved_byte_is_ignored_on_receipt_and_kept_for_the_round_trip() -> None:
+    """The spec requires 0 only of the header's reserved byte; a BEAT body's is ignored."""
+    from virja.rmcp.bodies import BeatBody
+
+    data = bytes.fromhex("00000003020400070007a120")
+    body = BeatBody.parse(data)
+    assert (body.bar, body.beat, body.beats_per_bar, body.level, body.tempo_us) == (
+        3,
+        2,
+        4,
+        0,
+        500_000,
+    )
+    assert bytes(body) == data

@@ -131,6 +131,7 @@ class BeatBody:
     beats_per_bar: int
     level: int
     tempo_us: int
+    reserved: int = 0  # senders write 0; a receiver ignores it (kept for the round trip)
 
     @classmethod
     def parse(cls, data: bytes) -> BeatBody:
@@ -142,12 +143,12 @@ class BeatBody:
             raise BadBodyError(f"BEAT beat must be 1-{bpb} (beats_per_bar), got {beat}")
         if tempo_us == 0:
             raise BadBodyError("BEAT tempo must be > 0 microseconds per beat")
-        if reserved != 0:
-            raise BadBodyError(f"BEAT reserved byte must be 0, got {reserved}")
-        return cls(bar, beat, bpb, level, tempo_us)
+        return cls(bar, beat, bpb, level, tempo_us, reserved)
 
     def __bytes__(self) -> bytes:
-        return BEAT_BODY.pack(self.bar, self.beat, self.beats_per_bar, self.level, 0, self.tempo_us)
+        return BEAT_BODY.pack(
+            self.bar, self.beat, self.beats_per_bar, self.level, self.reserved, self.tempo_us
+        )
 
 
 @dataclass(frozen=True, slots=True)

@@ -144,7 +144,6 @@ def pcap_input(
     report = [
         f"{path}: {cap.packets} packets, {len(cap.datagrams)} RMCP datagrams, "
         f"{stats['events']} events accepted, drops {stats['dropped'] or 'none'}",
-        *cap.warnings,
         *dry.report(),
     ]
     return PerformanceInput(

@@ -105,11 +105,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     only = next((a for a in args_list if a in COMMANDS), None)
     parser = build_parser(only)
     args = parser.parse_args(args_list)
+    command = args.command or "virja"
     logging.basicConfig(
         level=logging.WARNING - 10 * min(args.verbose, 2),
-        format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+        # plain one-liners like the errors; -v adds the time and the module
+        format=(
+            "%(asctime)s %(name)s %(levelname)s: %(message)s"
+            if args.verbose
+            else f"virja {command}: %(levelname)s: %(message)s".replace("virja virja", "virja")
+        ),
         stream=sys.stderr,
     )
+    logging.addLevelName(logging.WARNING, "warning" if not args.verbose else "WARNING")
     if args.command is None:
         parser.print_help()
         return NOT_YET

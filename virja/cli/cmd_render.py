@@ -202,7 +202,8 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
     rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
     where = out.path if out.kind != "png" or len(result.outputs) != 1 else result.outputs[0]
     print(
-        f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} ({t0:.2f} s to {t1:.2f} s at {args.fps:g} fps) to {where} "
+        f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} "
+        f"({t1 - t0:.2f} s at {args.fps:g} fps from session time {t0:.2f} s) to {where} "
         f"in {result.seconds:.1f} s ({rate:.1f} frames/s); "
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )

@@ -18,6 +18,7 @@ note.  Least total cost is found by dynamic programming over finger positions
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -72,9 +73,21 @@ def group_options(setup: BassSetup, pitches: Sequence[int]) -> tuple[int, list[B
     return 1, [(p,) for p in top]
 
 
+@functools.lru_cache(maxsize=4096)
+def chord_options(setup: BassSetup, pitches: tuple[int, ...]) -> tuple[int, tuple[BassOption, ...]]:
+    """:func:`group_options`, memoised: a pure function of hashable values (the setup is
+    a frozen dataclass), asked again for every chord of every re-plan.  The options are
+    a tuple, so the shared answer cannot be changed by a caller."""
+    kept, options = group_options(setup, pitches)
+    return kept, tuple(options)
+
+
 def anchor(option: BassOption) -> Position | None:
     """The stop the finger moves to for ``option`` (None when every note is open)."""
-    return next((p for p in option if p[1] > 0), None)
+    for p in option:
+        if p[1] > 0:
+            return p
+    return None
 
 
 def transition(state: BassState, option: BassOption) -> tuple[float, BassState]:
@@ -113,11 +126,20 @@ def solve(state: BassState, groups: Sequence[Sequence[BassOption]]) -> BassSolut
     best: dict[BassState, float] = {state: 0.0}
     backs: list[dict[BassState, tuple[BassState, int, float]]] = []
     for options in groups:
+        # :func:`transition` inlined, with each option's anchor found once per group
+        # instead of once per state (same arithmetic, same order, same results)
+        prepared = [(anchor(opt), opt[0][0]) for opt in options]
         nxt: dict[BassState, float] = {}
         back: dict[BassState, tuple[BassState, int, float]] = {}
         for prev, acc in best.items():
-            for k, opt in enumerate(options):
-                c, new = transition(prev, opt)
+            for k, (a, melody_string) in enumerate(prepared):
+                new: BassState
+                if prev is None:
+                    c, new = 0.0, a
+                elif a is None:
+                    c, new = float(abs(melody_string - prev[0])), prev
+                else:
+                    c, new = float(abs(a[1] - prev[1]) + abs(a[0] - prev[0])), a
                 total = acc + c
                 old = nxt.get(new)
                 if old is None or total < old:

@@ -15,8 +15,10 @@ Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 from virja.plan.config import DrumCosts, Timing
 
@@ -132,16 +134,44 @@ class HandSolution:
     total: float  # table costs + drop penalties
 
 
-def _compiled(
-    costs: DrumCosts, timing: Timing, group: HandGroup
-) -> list[tuple[Assignment, tuple[tuple[bool, int, float, int], ...], float]]:
-    """Per option: (assignment, played strokes left first as (is_right, motion, min
-    interval, stroke index), drop penalty) -- what :func:`transition` computes each time."""
-    out = []
-    for assign in options(group):
+@dataclass(frozen=True, slots=True)
+class _Option:
+    """One assignment of a group, precompiled: what :func:`transition` computes each time.
+
+    ``played`` lists the played strokes left hand first as ``(is_right, motion, min
+    interval - eps, stroke index)``; ``penalty`` is the sum of the drop penalties.
+    """
+
+    assign: Assignment
+    played: tuple[tuple[bool, int, float, int], ...]
+    penalty: float
+
+
+# A played option flattened for the solver's inner loop: (option index, interval the
+# right hand needs since its last stroke, the same for the left hand (-inf for a hand
+# that does not play), motion that ends the group (the next row), right hand plays,
+# left hand plays, penalty, first played motion, table cost first -> second played
+# motion (0.0 for one stroke)).
+_Played = tuple[int, float, float, int, bool, bool, float, int, float]
+
+
+@dataclass(frozen=True, slots=True)
+class _Compiled:
+    """Everything about a group's options that does not depend on its time."""
+
+    options: tuple[_Option, ...]  # in :func:`options` order
+    played: tuple[_Played, ...]  # the options that play something, in the same order
+    drop_penalty: float  # of the last option, which drops every stroke
+
+
+def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
+    """The options of :func:`options` for ``strokes``, precompiled, in the same order."""
+    opts = []
+    flat: list[_Played] = []
+    for k, assign in enumerate(options(HandGroup(0.0, strokes))):
         played = []
         penalty = 0.0
-        for i, (stroke, hand) in enumerate(zip(group.strokes, assign, strict=True)):
+        for i, (stroke, hand) in enumerate(zip(strokes, assign, strict=True)):
             if hand is None:
                 penalty += drop_penalty(costs, stroke)
             else:
@@ -154,8 +184,55 @@ def _compiled(
                     )
                 )
         played.sort(key=lambda p: p[0])  # left (False) first
-        out.append((assign, tuple(played), penalty))
-    return out
+        opts.append(_Option(assign, tuple(played), penalty))
+        if played:
+            need = {is_right: min_int for is_right, _m, min_int, _i in played}
+            first, last = played[0][1], played[-1][1]
+            flat.append(
+                (
+                    k,
+                    need.get(True, -math.inf),
+                    need.get(False, -math.inf),
+                    last,
+                    True in need,
+                    False in need,
+                    penalty,
+                    first,
+                    costs.table[first][last] if len(played) == 2 else 0.0,
+                )
+            )
+    assert not opts[-1].played  # the all-drop option is last
+    return _Compiled(tuple(opts), tuple(flat), opts[-1].penalty)
+
+
+# Compiled options depend only on (costs, timing, strokes), not on the group's time, so
+# they are kept across calls for the last configuration used (one per planner in
+# practice).  The entry holds the config objects themselves and is matched by identity,
+# so an id reused after garbage collection can never hit a stale entry; the tables are
+# frozen (configs are never mutated).  Reading the module global once makes the lookup
+# safe across threads: a replaced entry is a new tuple.
+_CACHE_LIMIT = 4096  # distinct stroke signatures (a kit gives a few hundred at most)
+_cache: tuple[DrumCosts, Timing, dict[tuple[Stroke, ...], _Compiled]] | None = None
+
+
+def _compiled(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
+    global _cache
+    entry = _cache
+    if entry is None or entry[0] is not costs or entry[1] is not timing:
+        entry = (costs, timing, {})
+        _cache = entry
+    table = entry[2]
+    comp = table.get(strokes)
+    if comp is None:
+        if len(table) >= _CACHE_LIMIT:
+            table.clear()
+        comp = table[strokes] = _compile(costs, timing, strokes)
+    return comp
+
+
+# A move out of states with given hand times: (option index, penalty, first motion,
+# pair cost, index of the state it leads to in the next layer).
+_Move = tuple[int, float, int, float, int]
 
 
 def solve(
@@ -165,87 +242,155 @@ def solve(
 
     Groups must be in time order.  Ties go to the earlier option of
     :func:`options` (left before right, drops last).  Each step is exactly
-    :func:`transition` (precompiled per group for speed).
+    :func:`transition` followed by :func:`_canonical`; the candidates of a step are
+    visited in order (states in the order they were first reached, options in
+    :func:`options` order) and a state keeps the first candidate of least total.
+    The loop is reorganised for speed without changing any result:
+
+    - Options are compiled once per stroke signature (:func:`_compiled`).
+    - Whether an option is feasible, and the hand times after it, depend only on the
+      source state's hand times ``(t_right, t_left)``, which several states share
+      (they differ in the previous motion).  So per group the feasible moves are
+      built once per distinct pair of hand times, with their target states already
+      looked up; a played option's target does not depend on the previous motion.
+      What does depend on it is only the first played stroke's cost: one table row
+      per state.  The all-drop option is always feasible and always last.
+      Feasibility is ``not (t - last < need)`` per hand, with ``t - last`` = inf for
+      a hand with no recent stroke and ``need`` = -inf for a hand that does not play:
+      the same comparisons as :func:`transition`.
+    - The states of a layer are numbered in the order they are first reached, and
+      the layer is kept as lists indexed by that number (cost, back-pointer).  A
+      target is numbered when its move is built, which happens at the first state
+      with those hand times, in visiting order, just before its candidates are
+      merged; so the numbering is exactly the insertion order of the dictionary the
+      plain DP would build, and the next layer is visited in the same order.
+    - Each total is summed in the same order as the plain DP (``acc + penalty +
+      first + pair``, which matters once costs are fractions) and merged with the
+      same strict ``<``, so ties resolve as before.  ``pair`` is 0.0 for a single
+      stroke: adding +0.0 changes no sum (a sum starting from +0.0 is never -0.0).
+
+    tests/plan/test_solver_equivalence.py keeps the plain DP and checks that every
+    result (assignments, per-stroke costs, states, total) is equal on random input.
     """
     max_interval = max(mt.min_interval_s for mt in timing.kinds.values())
     rest_s = timing.rest_s
     table = costs.table
-    none_row = costs.none_row
-    best: dict[HandState, float] = {state: 0.0}
-    # back-pointers keep (previous state, option index); the per-stroke costs are
-    # recomputed once on the way back instead of being built for every candidate
-    backs: list[dict[HandState, tuple[HandState, int]]] = []
+    none_row = table[costs.none_row]
+    inf = math.inf
+    played_t_ok = max_interval > 0.0  # a hand that plays now is remembered (unless all 0)
+    layer: list[HandState] = [state]  # the states reached, in first-reached order
+    accs: list[float] = [0.0]  # least objective reaching each
+    # back-pointers per group: the previous layer's state and the option index; the
+    # per-stroke costs are recomputed once on the way back
+    backs: list[tuple[list[int], list[int]]] = []
+    layers: list[list[HandState]] = []
     compiled_all = []
     for group in groups:
         t = group.time
-        compiled = _compiled(costs, timing, group)
-        compiled_all.append(compiled)
-        nxt: dict[HandState, float] = {}
-        back: dict[HandState, tuple[HandState, int]] = {}
-        for st, acc in best.items():
-            prev, prev_t, t_right, t_left = st
-            row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
-            for k, (_assign, played, penalty) in enumerate(compiled):
-                row = row0
-                tr, tl = t_right, t_left
-                total = acc + penalty
-                ok = True
-                for is_right, m, min_int, _i in played:
-                    last = tr if is_right else tl
-                    if last is not None and t - last < min_int:
-                        ok = False
-                        break
-                    total += table[none_row if row is None else row][m]
-                    row = m
-                    if is_right:
-                        tr = t
-                    else:
-                        tl = t
-                if not ok:
-                    continue
-                # _canonical, inlined (this loop is the scheduler's hot spot)
-                if played:
-                    np_, npt = row, t
-                elif prev_t is not None and t - prev_t >= rest_s:
-                    np_, npt = None, None
-                else:
-                    np_, npt = prev, prev_t
-                if tr is not None and t - tr >= max_interval:
-                    tr = None
-                if tl is not None and t - tl >= max_interval:
-                    tl = None
-                new = (np_, npt, tr, tl)
-                old = nxt.get(new)
+        played_t = t if played_t_ok else None
+        comp = _compiled(costs, timing, group.strokes)
+        compiled_all.append(comp)
+        drop_k = len(comp.options) - 1
+        drop_pen = comp.drop_penalty
+        played_opts = comp.played
+        moves_by_hands: dict[
+            tuple[float | None, float | None], tuple[list[_Move], float | None, float | None]
+        ] = {}
+        index: dict[HandState, int] = {}  # next layer: state -> its number
+        nxt: list[HandState] = []
+        # None until reached; every state is reached by the candidate that numbers it
+        nacc: list[float | None] = []
+        back_s: list[int] = []
+        back_k: list[int] = []
+        for sid, acc in enumerate(accs):
+            prev, prev_t, t_right, t_left = layer[sid]
+            hands = (t_right, t_left)
+            entry = moves_by_hands.get(hands)
+            if entry is None:
+                # hand times kept after the group (_canonical): forgotten once no
+                # later group can be constrained by them
+                keep_r = None if t_right is not None and t - t_right >= max_interval else t_right
+                keep_l = None if t_left is not None and t - t_left >= max_interval else t_left
+                since_r = inf if t_right is None else t - t_right
+                since_l = inf if t_left is None else t - t_left
+                moves: list[_Move] = []
+                for k, need_r, need_l, last, right, left, penalty, first, pair in played_opts:
+                    if since_r < need_r or since_l < need_l:
+                        continue
+                    new = (
+                        last,
+                        t,
+                        played_t if right else keep_r,
+                        played_t if left else keep_l,
+                    )
+                    nid = index.get(new)
+                    if nid is None:
+                        nid = index[new] = len(nxt)
+                        nxt.append(new)
+                        nacc.append(None)
+                        back_s.append(0)
+                        back_k.append(0)
+                    moves.append((k, penalty, first, pair, nid))
+                entry = moves_by_hands[hands] = (moves, keep_r, keep_l)
+            moves, keep_r, keep_l = entry
+            recent = prev_t is not None and t - prev_t < rest_s
+            row = table[prev] if prev is not None and recent else none_row
+            for k, penalty, first, pair, nid in moves:
+                total = acc + penalty + row[first] + pair
+                old = nacc[nid]
                 if old is None or total < old:
-                    nxt[new] = total
-                    back[new] = (st, k)
-        best = nxt
-        backs.append(back)
-    end = min(best, key=lambda s: best[s])
-    total = best[end]
+                    nacc[nid] = total
+                    back_s[nid] = sid
+                    back_k[nid] = k
+            # dropping every stroke: the previous motion is forgotten once rest_s old
+            dropped: HandState = (
+                (None, None, keep_r, keep_l)
+                if prev_t is not None and t - prev_t >= rest_s
+                else (prev, prev_t, keep_r, keep_l)
+            )
+            nid = index.get(dropped)
+            if nid is None:
+                nid = index[dropped] = len(nxt)
+                nxt.append(dropped)
+                nacc.append(None)
+                back_s.append(0)
+                back_k.append(0)
+            total = acc + drop_pen
+            old = nacc[nid]
+            if old is None or total < old:
+                nacc[nid] = total
+                back_s[nid] = sid
+                back_k[nid] = drop_k
+        layer, accs = nxt, cast(list[float], nacc)
+        layers.append(nxt)
+        backs.append((back_s, back_k))
+    # the first state (in layer order) of least objective
+    end = 0
+    for i, acc in enumerate(accs):
+        if acc < accs[end]:
+            end = i
     assigns: list[Assignment] = []
     pers: list[tuple[float, ...]] = []
     states: list[HandState] = []
     cur = end
-    for group, compiled, back in zip(
-        reversed(groups), reversed(compiled_all), reversed(backs), strict=True
-    ):
-        prev_st, k = back[cur]
-        assign, played, _penalty = compiled[k]
-        prev, prev_t = prev_st[0], prev_st[1]
-        row = (
+    for gi in range(len(groups) - 1, -1, -1):
+        back_s, back_k = backs[gi]
+        prev_id, k = back_s[cur], back_k[cur]
+        prev, prev_t = (layers[gi - 1] if gi > 0 else [state])[prev_id][:2]
+        opt = compiled_all[gi].options[k]
+        r = (
             prev
-            if prev is not None and prev_t is not None and group.time - prev_t < rest_s
+            if prev is not None and prev_t is not None and groups[gi].time - prev_t < rest_s
             else None
         )
-        per = [0.0] * len(group.strokes)
-        for _is_right, m, _min_int, i in played:
-            per[i] = table[none_row if row is None else row][m]
-            row = m
-        assigns.append(assign)
+        per = [0.0] * len(groups[gi].strokes)
+        for _is_right, m, _min_int, i in opt.played:
+            per[i] = table[costs.none_row if r is None else r][m]
+            r = m
+        assigns.append(opt.assign)
         pers.append(tuple(per))
-        states.append(cur)
-        cur = prev_st
+        states.append(layers[gi][cur])
+        cur = prev_id
     return HandSolution(
-        tuple(reversed(assigns)), tuple(reversed(pers)), tuple(reversed(states)), total
+        tuple(reversed(assigns)), tuple(reversed(pers)), tuple(reversed(states)), accs[end]
     )

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import bisect
 import logging
+import math
 from collections import Counter, deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -47,7 +48,7 @@ def _config(config: PlanConfig | None) -> PlanConfig:
     return _default_config
 
 
-@dataclass
+@dataclass(slots=True)
 class _Rec:
     """A note the planner holds."""
 
@@ -64,10 +65,13 @@ class _Rec:
     late: bool = False
 
 
-@dataclass
+@dataclass(slots=True)
 class _Chain:
     name: str
     pending: list[_Rec] = field(default_factory=list)
+    # min(r.start for r in pending), inf when none: kept up to date on every change of
+    # pending so that each call need not scan it (it is checked on every note)
+    min_start: float = math.inf
     state: Any = None  # bass: finger; hands: HandState; feet: last stroke time
     last_fixed_t: float | None = None
     fixed: list[tuple[float, PlannedNote]] = field(default_factory=list)  # recent, for sharing
@@ -135,6 +139,7 @@ class OnlinePlanner:
             self._place_out_of_order(chain, rec)
         else:
             chain.pending.append(rec)
+            chain.min_start = min(chain.min_start, rec.start)
             chain.plan = None
 
     # -- outputs --------------------------------------------------------------
@@ -149,7 +154,8 @@ class OnlinePlanner:
     def flush(self) -> list[PlannedNote]:
         """Everything still held, planned and fixed, in start order."""
         for chain in self._chains.values():
-            self._fix(chain, len(_groups(chain.pending)))
+            groups = _groups(chain.pending)
+            self._fix(chain, groups, len(groups))
         out = sorted(self._outbox, key=lambda p: (p.start, p.time))
         self._outbox = []
         return out
@@ -212,18 +218,18 @@ class OnlinePlanner:
 
     def _commit(self, now_s: float) -> None:
         for chain in self._chains.values():
-            if not chain.pending or min(r.start for r in chain.pending) > now_s:
+            if chain.min_start > now_s:  # nothing pending has started (or none pending)
                 continue
             groups = _groups(chain.pending)
             started = [i for i, g in enumerate(groups) if min(r.start for r in g) <= now_s]
             if started:
-                self._fix(chain, started[-1] + 1)
+                self._fix(chain, groups, started[-1] + 1)
 
-    def _fix(self, chain: _Chain, n_groups: int) -> None:
-        """Plan the chain's pending notes and fix its first ``n_groups`` groups."""
+    def _fix(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
+        """Plan the chain's pending notes and fix the first ``n_groups`` of their
+        ``groups`` (:func:`_groups` of the pending notes)."""
         if n_groups == 0 or not chain.pending:
             return
-        groups = _groups(chain.pending)
         if chain.name == "bass":
             self._fix_bass(chain, groups, n_groups)
         elif chain.name == "hands":
@@ -234,6 +240,7 @@ class OnlinePlanner:
             chain.plan = chain.plan[n_groups:]
         fixed = {r.seq for g in groups[:n_groups] for r in g}
         chain.pending = [r for r in chain.pending if r.seq not in fixed]
+        chain.min_start = min((r.start for r in chain.pending), default=math.inf)
         chain.last_fixed_t = groups[n_groups - 1][0].note.time_s
         chain.fixed = chain.fixed[-HISTORY:]
 
@@ -256,9 +263,9 @@ class OnlinePlanner:
 
     # bass ---------------------------------------------------------------------
 
-    def _bass_group(self, group: list[_Rec]) -> tuple[list[int], list[bass_mod.BassOption]]:
+    def _bass_group(self, group: list[_Rec]) -> tuple[list[int], tuple[bass_mod.BassOption, ...]]:
         pitches = sorted({r.played for r in group}, reverse=True)
-        kept, options = bass_mod.group_options(self.config.bass, pitches)
+        kept, options = bass_mod.chord_options(self.config.bass, tuple(pitches))
         return pitches[:kept], options
 
     def _fix_bass(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
@@ -308,12 +315,13 @@ class OnlinePlanner:
             assert r.drum is not None
             by_piece.setdefault(r.drum.piece, []).append(r)
 
-        def rank(piece: str) -> tuple[int, int]:
-            recs = by_piece[piece]
-            return (min(r.drum.priority for r in recs if r.drum), min(r.seq for r in recs))
-
-        pieces = sorted(by_piece, key=rank)
-        strokes = tuple(drums_mod.Stroke(p, rank(p)[0]) for p in pieces)
+        # best priority first, then the piece heard first
+        rank = {
+            piece: (min(r.drum.priority for r in recs if r.drum), min(r.seq for r in recs))
+            for piece, recs in by_piece.items()
+        }
+        pieces = sorted(by_piece, key=rank.__getitem__)
+        strokes = tuple(drums_mod.Stroke(p, rank[p][0]) for p in pieces)
         return drums_mod.HandGroup(group[0].note.time_s, strokes), by_piece
 
     def _fix_hands(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:

@@ -1,0 +1,217 @@
+"""The fast solvers equal the plain dynamic programmes they replaced, result for result.
+
+``virja.plan.drums.solve`` and ``virja.plan.bass.solve`` are reorganised for speed
+(compiled options, moves shared by states with the same hand times, numbered
+layers).  The plain versions are kept here as references; on seeded random input,
+including cost tables with fractions and negative numbers (where the order of
+additions could matter), zero intervals and odd start states, every assignment,
+per-stroke cost, state and total must be identical, ties included.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Sequence
+
+from virja.plan import bass, drums
+from virja.plan.config import DrumCosts, MotionTiming, PlanConfig, Timing
+from virja.plan.drums import RIGHT, Assignment, HandGroup, HandSolution, HandState, Stroke
+
+
+def _reference_drums(
+    costs: DrumCosts, timing: Timing, state: HandState, groups: Sequence[HandGroup]
+) -> HandSolution:
+    """The plain DP over hand states (the solver as it was before it was sped up)."""
+    max_interval = max(mt.min_interval_s for mt in timing.kinds.values())
+    rest_s, table, none_row = timing.rest_s, costs.table, costs.none_row
+    best: dict[HandState, float] = {state: 0.0}
+    backs: list[dict[HandState, tuple[HandState, int]]] = []
+    compiled_all = []
+    for group in groups:
+        t = group.time
+        compiled = []
+        for assign in drums.options(group):
+            plays, penalty = [], 0.0
+            for i, (stroke, hand) in enumerate(zip(group.strokes, assign, strict=True)):
+                if hand is None:
+                    penalty += drums.drop_penalty(costs, stroke)
+                else:
+                    min_int = timing.get(stroke.piece).min_interval_s - drums.TIME_EPS_S
+                    plays.append((hand == RIGHT, costs.index(stroke.piece, hand), min_int, i))
+            plays.sort(key=lambda p: p[0])  # left hand first
+            compiled.append((assign, tuple(plays), penalty))
+        compiled_all.append(compiled)
+        nxt: dict[HandState, float] = {}
+        back: dict[HandState, tuple[HandState, int]] = {}
+        for st, acc in best.items():
+            prev, prev_t, t_right, t_left = st
+            row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
+            for k, (_assign, played, penalty) in enumerate(compiled):
+                row, tr, tl, total, ok = row0, t_right, t_left, acc + penalty, True
+                for is_right, m, min_int, _i in played:
+                    last = tr if is_right else tl
+                    if last is not None and t - last < min_int:
+                        ok = False
+                        break
+                    total += table[none_row if row is None else row][m]
+                    row = m
+                    if is_right:
+                        tr = t
+                    else:
+                        tl = t
+                if not ok:
+                    continue
+                if played:
+                    np_, npt = row, t
+                elif prev_t is not None and t - prev_t >= rest_s:
+                    np_, npt = None, None
+                else:
+                    np_, npt = prev, prev_t
+                if tr is not None and t - tr >= max_interval:
+                    tr = None
+                if tl is not None and t - tl >= max_interval:
+                    tl = None
+                new = (np_, npt, tr, tl)
+                old = nxt.get(new)
+                if old is None or total < old:
+                    nxt[new] = total
+                    back[new] = (st, k)
+        best = nxt
+        backs.append(back)
+    end = min(best, key=lambda s: best[s])
+    assigns: list[Assignment] = []
+    pers: list[tuple[float, ...]] = []
+    states: list[HandState] = []
+    cur = end
+    for group, compiled, back in zip(
+        reversed(groups), reversed(compiled_all), reversed(backs), strict=True
+    ):
+        prev_st, k = back[cur]
+        assign, played, _penalty = compiled[k]
+        prev, prev_t = prev_st[0], prev_st[1]
+        r = (
+            prev
+            if prev is not None and prev_t is not None and group.time - prev_t < rest_s
+            else None
+        )
+        per = [0.0] * len(group.strokes)
+        for _is_right, m, _min_int, i in played:
+            per[i] = table[none_row if r is None else r][m]
+            r = m
+        assigns.append(assign)
+        pers.append(tuple(per))
+        states.append(cur)
+        cur = prev_st
+    return HandSolution(
+        tuple(reversed(assigns)), tuple(reversed(pers)), tuple(reversed(states)), best[end]
+    )
+
+
+PIECES = ["snare", "hihat", "tom_high", "tom_low", "tom_floor", "ride", "crash"]
+ODD_COSTS = [-2.5, -1.0, 0.0, 0.1, 0.2, 0.5, 1.0, 1.25, 3.0, 9.0]
+
+
+def _random_case(
+    rng: random.Random, config: PlanConfig
+) -> tuple[DrumCosts, Timing, HandState, list[HandGroup]]:
+    costs, timing = config.costs, config.timing
+    if rng.random() < 0.4:  # fractions and negatives: ties and rounding must match too
+        table = tuple(
+            tuple(rng.choice(ODD_COSTS) if rng.random() < 0.5 else float(rng.randint(0, 3))
+                  for _ in range(14))
+            for _ in range(15)
+        )  # fmt: skip
+        costs = DrumCosts(costs.motions, table, rng.choice([1000.0, 0.0, 2.5, -3.0, 0.1]))
+    if rng.random() < 0.3:  # zero, tiny and long intervals, no rest or a short one
+        kinds = {
+            k: MotionTiming(
+                v.anticipation_s,
+                v.min_anticipation_s,
+                rng.choice([0.0, 0.03, 0.07, 0.2, v.min_interval_s]),
+            )
+            for k, v in timing.kinds.items()
+        }
+        timing = Timing(timing.reference_spb, rng.choice([0.0, 0.1, 1.5]), kinds)
+    state = drums.START
+    if rng.random() < 0.3:  # a fixed state left by an earlier plan
+        state = (
+            rng.choice([None, rng.randrange(14)]),
+            rng.choice([None, -0.05, -1.0]),
+            rng.choice([None, -0.02, -0.1]),
+            rng.choice([None, -0.01, -0.06]),
+        )
+    t = rng.choice([0.0, 3.0])
+    groups = []
+    for _ in range(rng.randint(0, 10)):
+        t += rng.choice([0.0, 0.03, 0.0625, 0.07, 0.08, 0.125, 0.15, 0.25, 2.0])
+        pieces = rng.sample(PIECES, rng.choice([1, 2, 2]))
+        groups.append(HandGroup(t, tuple(Stroke(p, rng.randint(0, 12)) for p in pieces)))
+    return costs, timing, state, groups
+
+
+def test_drum_solver_equals_the_plain_dp_on_random_input(config: PlanConfig) -> None:
+    rng = random.Random(2024)
+    for _ in range(600):
+        costs, timing, state, groups = _random_case(rng, config)
+        assert drums.solve(costs, timing, state, groups) == _reference_drums(
+            costs, timing, state, groups
+        )
+
+
+def test_drum_solver_results_do_not_depend_on_earlier_calls(config: PlanConfig) -> None:
+    """Compiled options are cached per configuration: another config in between
+    (same stroke signatures, other tables) must not leak into the next result."""
+    rng = random.Random(7)
+    cases = [_random_case(rng, config) for _ in range(60)]
+    first = [drums.solve(*case) for case in cases]
+    again = [drums.solve(*case) for case in reversed(cases)]
+    assert first == list(reversed(again))
+
+
+def _reference_bass(
+    state: bass.BassState, groups: Sequence[Sequence[bass.BassOption]]
+) -> bass.BassSolution:
+    """The plain Viterbi with :func:`virja.plan.bass.transition` per candidate."""
+    best: dict[bass.BassState, float] = {state: 0.0}
+    backs = []
+    for options in groups:
+        nxt: dict[bass.BassState, float] = {}
+        back: dict[bass.BassState, tuple[bass.BassState, int, float]] = {}
+        for prev, acc in best.items():
+            for k, opt in enumerate(options):
+                c, new = bass.transition(prev, opt)
+                if (old := nxt.get(new)) is None or acc + c < old:
+                    nxt[new] = acc + c
+                    back[new] = (prev, k, c)
+        best = nxt
+        backs.append(back)
+    end = min(best, key=lambda s: best[s])
+    choice, costs, states = [], [], []
+    cur = end
+    for back in reversed(backs):
+        prev, k, c = back[cur]
+        choice.append(k)
+        costs.append(c)
+        states.append(cur)
+        cur = prev
+    return bass.BassSolution(
+        tuple(reversed(choice)), tuple(reversed(costs)), tuple(reversed(states)), best[end]
+    )
+
+
+def test_bass_solver_equals_the_plain_viterbi_on_random_input(config: PlanConfig) -> None:
+    rng = random.Random(5)
+    setup = config.bass
+    for _ in range(300):
+        groups = []
+        for _ in range(rng.randint(0, 12)):
+            pitches = sorted(
+                {
+                    bass.fold_into_range(setup, rng.randint(20, 80))
+                    for _ in range(rng.randint(1, 3))
+                },
+                reverse=True,
+            )
+            groups.append(bass.group_options(setup, pitches)[1])
+        state = rng.choice([None, (0, 3), (3, 12), (1, 1)])
+        assert bass.solve(state, groups) == _reference_bass(state, groups)

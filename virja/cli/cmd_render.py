@@ -34,6 +34,7 @@ from virja.render.camera import PRESETS
 
 if TYPE_CHECKING:
     from virja.dance.stage import DancerTrack
+    from virja.render.renderer import DrawList
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -170,15 +171,16 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             if why_not:
                 print(f"virja: {why_not}", file=sys.stderr)
         progress = ProgressBar("rendering") if out.kind != "png" or args.at is None else None
-        render = render_offline
+        extra = None
         if dancer_db is not None:
-            from functools import partial
-
-            from virja.render.dancer import render_with_dancer
+            from virja.render.scene import figure_scene
 
             track = session_dancer(src, dancer_db, audio, Path(tmp), args.soundfont)
-            render = partial(render_with_dancer, dancer=track.pose)
-        result = render(
+
+            def extra(t: float) -> list[DrawList]:
+                return [figure_scene(track.pose(t))]
+
+        result = render_offline(
             perf,
             feeder,
             t0_s=t0,
@@ -191,6 +193,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             audio_offset_s=src.sound_origin_s - t0,
             samples=args.samples,
             progress=progress,
+            extra=extra,
         )
     if plan_log is not None:
         plan_log.close()

@@ -7,8 +7,9 @@ drawn each frame by :func:`~virja.render.scene.figure_scene`.  The dancer's
 pose comes from a callable (session time -> FigurePose), so this module knows
 nothing of how the dance was made (``virja.dance.stage.DancerTrack.pose``).
 
-:func:`render_with_dancer` draws the band and the dancer;
-:func:`render_dancer_alone` draws only the stage floor and the dancer.
+:func:`render_dancer_alone` draws only the stage floor and the dancer; with
+the band, ``virja render --dancer`` passes the dancer to
+:func:`virja.render.offline.render_offline` as its ``extra`` layer.
 """
 
 from __future__ import annotations
@@ -19,10 +20,10 @@ from pathlib import Path
 from virja.motion.pose import FigurePose
 from virja.render.camera import Camera
 from virja.render.meshes import box_transforms
-from virja.render.offline import OutputSpec, Progress, RenderResult, render_frames, render_offline
+from virja.render.offline import OutputSpec, Progress, RenderResult, render_frames
 from virja.render.renderer import DrawList
 from virja.render.scene import FLOOR, figure_scene
-from virja.session import Performance, RevealFeeder, frame_times
+from virja.session import frame_times
 
 DancerPose = Callable[[float], FigurePose]
 
@@ -33,40 +34,6 @@ def floor_scene(size_m: tuple[float, float] = (6.0, 4.0)) -> DrawList:
     w, d = size_m
     dl.add("box", box_transforms([[0, -0.05, 0]], [[w, 0.1, d]]), FLOOR)
     return dl.freeze()
-
-
-def render_with_dancer(
-    perf: Performance,
-    feeder: RevealFeeder,
-    *,
-    dancer: DancerPose,
-    t0_s: float,
-    t1_s: float,
-    fps: float,
-    size: tuple[int, int],
-    out: OutputSpec,
-    camera: Camera,
-    audio: Path | None = None,
-    audio_offset_s: float = 0.0,
-    samples: int = 1,
-    progress: Progress | None = None,
-) -> RenderResult:
-    """As :func:`virja.render.offline.render_offline`, with ``dancer(t)`` drawn each frame."""
-    return render_offline(
-        perf,
-        feeder,
-        t0_s=t0_s,
-        t1_s=t1_s,
-        fps=fps,
-        size=size,
-        out=out,
-        camera=camera,
-        audio=audio,
-        audio_offset_s=audio_offset_s,
-        samples=samples,
-        progress=progress,
-        extra=lambda t: [figure_scene(dancer(t))],
-    )
 
 
 def render_dancer_alone(

@@ -24,7 +24,7 @@ from virja.jam.ports import quiet_c_stderr
 WAIT_S = 10.0  # upper bound of every wait; a healthy server answers in milliseconds
 
 
-def wait_until(predicate: Callable[[], bool], timeout_s: float = WAIT_S) -> bool:
+def wait_until(predicate: Callable[[], object], timeout_s: float = WAIT_S) -> bool:
     """Poll ``predicate`` until true or ``timeout_s`` passes (bounded); its last value."""
     end = time.monotonic() + timeout_s
     while True:

@@ -6,7 +6,6 @@ import json
 import os
 import threading
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,17 +19,7 @@ from virja.jam.ports import list_ports
 if TYPE_CHECKING:
     from tests.jam.conftest import JackKeyboard
 
-WAIT_S = 10.0  # bound of every wait; a healthy JACK server answers in milliseconds
-
-
-def wait_until(predicate: Callable[[], object], timeout_s: float = WAIT_S) -> bool:
-    """Poll ``predicate`` until true or ``timeout_s`` passes (a bounded loop)."""
-    end = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.005)
-    return True
+from tests.jam.conftest import wait_until  # noqa: E402
 
 
 def test_flags_override_the_config_table() -> None:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 import pytest
@@ -27,17 +27,7 @@ pytestmark = pytest.mark.jack
 if TYPE_CHECKING:
     from tests.jam.conftest import JackKeyboard, Recorder
 
-WAIT_S = 10.0  # bound of every wait; a healthy JACK server answers in milliseconds
-
-
-def wait_until(predicate: Callable[[], object], timeout_s: float = WAIT_S) -> bool:
-    """Poll ``predicate`` until true or ``timeout_s`` passes (a bounded loop)."""
-    end = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > end:
-            return False
-        time.sleep(0.005)
-    return True
+from tests.jam.conftest import wait_until  # noqa: E402
 
 
 class JackSynth:

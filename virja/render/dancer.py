@@ -19,10 +19,9 @@ from pathlib import Path
 
 from virja.motion.pose import FigurePose
 from virja.render.camera import Camera
-from virja.render.meshes import box_transforms
 from virja.render.offline import OutputSpec, Progress, RenderResult, render_frames
 from virja.render.renderer import DrawList
-from virja.render.scene import FLOOR, figure_scene
+from virja.render.scene import add_floor, figure_scene
 from virja.session import frame_times
 
 DancerPose = Callable[[float], FigurePose]
@@ -31,8 +30,7 @@ DancerPose = Callable[[float], FigurePose]
 def floor_scene(size_m: tuple[float, float] = (6.0, 4.0)) -> DrawList:
     """Just the stage floor (for a dancer alone)."""
     dl = DrawList()
-    w, d = size_m
-    dl.add("box", box_transforms([[0, -0.05, 0]], [[w, 0.1, d]]), FLOOR)
+    add_floor(dl, size_m)
     return dl.freeze()
 
 

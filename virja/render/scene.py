@@ -59,11 +59,16 @@ def _rotation_to(axis: F64) -> F64:
     return np.stack([x, y, z], axis=1)
 
 
+def add_floor(dl: DrawList, size_m: tuple[float, float]) -> None:
+    """The stage floor: a slab whose top is y = 0, ``size_m`` (x, z) metres."""
+    w, d = size_m
+    dl.add("box", box_transforms([[0, -0.05, 0]], [[w, 0.1, d]]), FLOOR)
+
+
 def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
     """The floor, drum shells and stands, the throne, the bass body and neck."""
     dl = DrawList()
-    w, d = geo.stage.floor_size
-    dl.add("box", box_transforms([[0, -0.05, 0]], [[w, 0.1, d]]), FLOOR)
+    add_floor(dl, geo.stage.floor_size)
     kit = geo.kit
     dl.add(
         "cylinder",

@@ -28,6 +28,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "render": ("virja.cli.cmd_render", "render a MIDI file or a recording to PNG frames or video"),
     "replay": ("virja.cli.cmd_replay", "replay a pcap recording of RMCP traffic"),
     "jam": ("virja.cli.cmd_jam", "play a MIDI keyboard, the band plays what you play"),
+    "batch": (
+        "virja.cli.cmd_batch",
+        "plan, export or render a whole folder of MIDI files (locally or on Ray)",
+    ),
     "bench": ("virja.cli.cmd_bench", "measure speed and latency on this machine"),
     "motion-report": ("virja.cli.cmd_motion_report", "impact, contact and continuity metrics"),
     "beats": ("virja.cli.cmd_beats", "extract beat times from audio"),

@@ -1,0 +1,150 @@
+"""One input to its outputs: the work a worker process or a Ray task does.
+
+:func:`run_job` takes the input's bytes (so a worker on another machine needs
+no shared filesystem), plans and animates it through the same pipeline as a
+performance (``virja.input`` reveal schedule -> ``session.Performance``), and
+returns every output as bytes.  It never raises: a failure is a result with
+status ``error`` and a one-line message naming the input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+
+from virja.batch.jobs import Job, OutputKind
+from virja.batch.manifest import JobResult, Status
+from virja.errors import InputFileError, VirjaError
+from virja.input import PerformanceInput, load_performance_input
+from virja.plan.config import PlanConfig
+from virja.routing import Router, RoutingConfig
+from virja.session import Performance, RevealFeeder, frame_times, run_schedule
+
+
+@dataclass(frozen=True)
+class BatchSettings:
+    """Everything a job needs besides its input, parsed once by the driver
+    (plain data: it travels to worker processes and Ray tasks by pickle)."""
+
+    plan: PlanConfig
+    routing: RoutingConfig
+    lookahead_beats: float = 1.0
+    fps: float = 30.0
+    size: tuple[int, int] = (1280, 720)
+    soundfont: str | None = None
+
+
+def _performance(src: PerformanceInput, settings: BatchSettings, *, animate: bool) -> Performance:
+    from virja.plan.planner import OnlinePlanner
+
+    router = (
+        Router.for_session(src.midi, settings.routing)
+        if src.midi is not None
+        else Router(settings.routing)
+    )
+    animator = None
+    if animate:
+        from virja.motion.band import BandAnimator
+
+        animator = BandAnimator()
+    return Performance(
+        router=router, planner=OnlinePlanner(settings.plan, tempo=src.tempo), animator=animator
+    )
+
+
+def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
+    perf = _performance(src, settings, animate=False)
+    planned = run_schedule(perf, src.schedule)
+    path = out / "plan.jsonl"
+    path.write_text("".join(json.dumps(p.to_json()) + "\n" for p in planned), encoding="utf-8")
+    return [path]
+
+
+def _make_bvh(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
+    from virja.motion.export import performance_to_bvh
+
+    perf = _performance(src, settings, animate=True)
+    assert perf.animator is not None
+    t0, t1 = src.default_span()
+    feeder = RevealFeeder(src.schedule)
+    for t in frame_times(t0, t1, settings.fps):
+        feeder.until(perf, t)
+        perf.advance(t)
+    feeder.until(perf, math.inf)
+    perf.finish()
+    return performance_to_bvh(perf.animator, t0, t1, settings.fps, out / "take.bvh")
+
+
+def _make_mp4(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
+    from virja.render.camera import PRESETS
+    from virja.render.offline import OutputSpec, render_offline
+    from virja.render.video import make_audio_track
+
+    perf = _performance(src, settings, animate=True)
+    t0, t1 = src.default_span()
+    video = out / "take.mp4"
+    audio, _why_not = make_audio_track(
+        src.sound_events, src.sound_origin_s, out, settings.soundfont
+    )
+    render_offline(
+        perf,
+        RevealFeeder(src.schedule),
+        t0_s=t0,
+        t1_s=t1,
+        fps=settings.fps,
+        size=settings.size,
+        out=OutputSpec("video", video),
+        camera=PRESETS["front"],
+        audio=audio,
+        audio_offset_s=src.sound_origin_s - t0,
+    )
+    return [video]
+
+
+Producer = Callable[[PerformanceInput, Path, BatchSettings], list[Path]]
+
+# each producer returns its files in the order of jobs.OUTPUT_NAMES[kind]
+PRODUCERS: dict[OutputKind, Producer] = {
+    OutputKind.PLAN: _make_plan,
+    OutputKind.BVH: _make_bvh,
+    OutputKind.MP4: _make_mp4,
+}
+
+
+def _message(exc: BaseException, tmp_input: Path, rel: str) -> str:
+    text = str(exc) if isinstance(exc, VirjaError) else f"{type(exc).__name__}: {exc}"
+    return " ".join(text.replace(str(tmp_input), rel).split()) or type(exc).__name__
+
+
+def run_job(job: Job, data: bytes, settings: BatchSettings) -> JobResult:
+    """Make every output of ``job`` from the input's bytes ``data``; never raises."""
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="virja-batch-") as tmp:
+        src_path = Path(tmp) / PurePosixPath(job.rel).name
+        try:
+            src_path.write_bytes(data)
+            src = load_performance_input(
+                src_path, settings.routing, lookahead_beats=settings.lookahead_beats
+            )
+            if src.note_count == 0:
+                raise InputFileError(src_path, "no notes for the band (bass or drums)")
+            files: dict[str, bytes] = {}
+            for kind in job.kinds:
+                out = Path(tmp) / kind.value
+                out.mkdir()
+                made = PRODUCERS[kind](src, out, settings)
+                for name, path in zip(job.output_names(kind), made, strict=True):
+                    files[name] = path.read_bytes()
+        except Exception as exc:  # one bad file never stops the batch
+            return JobResult(
+                job.rel,
+                Status.ERROR,
+                time.perf_counter() - started,
+                error=_message(exc, src_path, job.rel),
+            )
+    return JobResult(job.rel, Status.OK, time.perf_counter() - started, files=files)

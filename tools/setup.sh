@@ -30,8 +30,8 @@ if [ ! -x .venv/bin/python ]; then
 fi
 stamp=.venv/.virja-installed
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
-  echo "setup: installing virja and its test tools into .venv"
+  echo "setup: installing virja, its test tools and the Ray extra into .venv"
   .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-  .venv/bin/python -m pip install -q -e '.[test]'
+  .venv/bin/python -m pip install -q -e '.[test,ray]'
   touch "$stamp"
 fi

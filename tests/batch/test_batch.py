@@ -145,6 +145,7 @@ def test_batch_on_the_process_pool_writes_outputs_and_a_manifest(
         ]
         for p in row["outputs"]:
             assert Path(p).is_file() and Path(p).stat().st_size > 0
+            assert Path(p).stat().st_mode & 0o644 == 0o644  # ordinary files, not mkstemp's 0600
     # the plan is exactly `virja plan --json`'s
     take = corpus / TAKES[0]
     expected = virja_plan_json(take, capsys)

@@ -59,10 +59,18 @@ def outputs_exist(out_dir: Path, names: tuple[str, ...]) -> bool:
     return bool(names) and all((out_dir / name).is_file() for name in names)
 
 
+def _file_mode() -> int:
+    """rw for everyone the umask allows, as ``open()`` would create the file."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def place_outputs(result: JobResult, out_dir: Path) -> None:
     """Write ``result.files`` into ``out_dir`` atomically; on failure the result
     becomes an error naming the file and the reason, and no partial file stays."""
     partial = out_dir / PARTIAL_DIR
+    mode = _file_mode()
     placed: list[str] = []
     try:
         partial.mkdir(parents=True, exist_ok=True)
@@ -71,6 +79,7 @@ def place_outputs(result: JobResult, out_dir: Path) -> None:
             final.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(dir=partial, prefix=final.name + ".")
             try:
+                os.fchmod(fd, mode)  # mkstemp makes 0600; outputs are ordinary files
                 with os.fdopen(fd, "wb") as fh:
                     fh.write(data)
                     fh.flush()

@@ -102,7 +102,8 @@ def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> Pe
     notes = _band_notes(session.events, dry)
     events: list[Event] = [*session.events, *session.beats]
     events.sort(key=lambda e: e.time_s)
-    report = [f"{path}: {len(session.tracks)} tracks, {session.duration_s:.1f} s", *dry.report()]
+    n = len(session.tracks)
+    report = [f"{path}: {n} track{'' if n == 1 else 's'}, {session.duration_s:.1f} s", *dry.report()]
     return PerformanceInput(
         kind="midi",
         path=path,

@@ -16,6 +16,7 @@ examples:
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,6 +25,7 @@ from virja.cli.common import (
     SAMPLE_CHOICES,
     ProgressBar,
     add_routing_arguments,
+    check_writable,
     finite_float,
     make_router,
     open_plan_log,
@@ -35,6 +37,8 @@ from virja.render.camera import PRESETS
 if TYPE_CHECKING:
     from virja.dance.stage import DancerTrack
     from virja.render.renderer import DrawList
+
+log = logging.getLogger(__name__)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -123,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
     out = OutputSpec.from_path(args.out)
     if args.at is not None and out.kind != "png":
         raise ConfigError("--at renders one frame: give --out NAME.png")
+    check_outputs(args, out)
     src = load_performance_input(
         Path(args.input), routing_config(args), lookahead_beats=args.lookahead_beats
     )
@@ -131,6 +136,23 @@ def run(args: argparse.Namespace) -> int:
     if src.note_count == 0:
         raise InputFileError(args.input, "no notes for the band (bass or drums) in this input")
     return render_input(src, args, size, out)
+
+
+def check_outputs(args: argparse.Namespace, out: object) -> None:
+    """Every file the render will write is writable, and the soundfont is one: checked
+    before the (long) work, each a one-line error.  Shared by `render` and `replay --out`."""
+    from virja.motion.export import bvh_paths
+    from virja.render.offline import OutputSpec
+    from virja.render.video import check_soundfont
+
+    assert isinstance(out, OutputSpec)
+    one_file = out.kind == "video" or (out.kind == "png" and args.at is not None)
+    check_writable(out.path if one_file else out.frame_path(0), "--out")
+    if getattr(args, "bvh", None):
+        for path in bvh_paths(Path(args.bvh)):
+            check_writable(path, "--bvh")
+    if getattr(args, "soundfont", None) and out.kind == "video" and not args.no_audio:
+        check_soundfont(Path(args.soundfont), "--soundfont")
 
 
 def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], out: object) -> int:
@@ -161,6 +183,14 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         # everything known before the frame must have been fed: start the feeder there
     if t1 < t0:
         raise ConfigError(f"nothing to render: end {t1:.3f} s is before start {t0:.3f} s")
+    first_s, last_s = src.default_span()
+    if args.at is not None and not first_s <= args.at <= last_s:
+        log.warning(
+            "--at %.3f s is outside the performance (%.3f to %.3f s): the band is idle there",
+            args.at,
+            first_s,
+            last_s,
+        )
     dancer_db = getattr(args, "dancer", None)
     with temp_workdir() as tmp:
         audio = None
@@ -203,7 +233,11 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         for path in performance_to_bvh(animator, t0, t1, args.fps, Path(args.bvh)):
             print(f"wrote {path}")
     rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
-    where = out.path if out.kind != "png" or len(result.outputs) != 1 else result.outputs[0]
+    where: object = out.path
+    if out.kind != "video" and len(result.outputs) == 1:
+        where = result.outputs[0]
+    elif out.kind != "video" and result.outputs:
+        where = f"{result.outputs[0]} ... {result.outputs[-1].name}"
     print(
         f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} "
         f"({t1 - t0:.2f} s at {args.fps:g} fps from session time {t0:.2f} s) to {where} "

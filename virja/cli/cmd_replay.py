@@ -70,6 +70,14 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--port must be 1-65535, got {args.port}")
     if args.dancer and not args.out:
         raise ConfigError("--dancer draws into a rendering: give --out too")
+    if args.out:
+        from virja.cli.cmd_render import check_outputs
+        from virja.render.offline import OutputSpec, parse_size
+
+        args.at = args.start = args.end = None
+        args.bvh = None
+        size, out = parse_size(args.size), OutputSpec.from_path(args.out)
+        check_outputs(args, out)  # before the work
     src = pcap_input(Path(args.input), routing_config(args), port=args.port, key_file=args.key_file)
     for line in src.report:
         print(line)
@@ -77,11 +85,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputFileError(args.input, "the recording holds no valid RMCP events")
     if args.out:
         from virja.cli.cmd_render import render_input
-        from virja.render.offline import OutputSpec, parse_size
 
-        args.at = args.start = args.end = None
-        args.bvh = None
-        return render_input(src, args, parse_size(args.size), OutputSpec.from_path(args.out))
+        return render_input(src, args, size, out)
     return play(src, args)
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from virja.config import load_config, section
+from virja.errors import ConfigError
 from virja.routing import Router, RoutingConfig
 
 
@@ -83,12 +84,37 @@ def make_router(args: argparse.Namespace, session: Any = None) -> Router:
 
 
 def open_plan_log(path: str | None) -> IO[str] | None:
+    """The plan log, opened now (before any work), or a one-line ConfigError."""
     if not path:
         return None
     p = Path(path)
-    if p.parent and not p.parent.exists():
-        p.parent.mkdir(parents=True, exist_ok=True)
-    return p.open("w", encoding="utf-8", buffering=1)
+    try:
+        if p.parent and not p.parent.exists():
+            p.parent.mkdir(parents=True, exist_ok=True)
+        return p.open("w", encoding="utf-8", buffering=1)
+    except OSError as exc:
+        raise ConfigError(
+            f"--plan-log {path}: cannot write it: {exc.strerror or exc}; give a writable path"
+        ) from None
+
+
+def check_writable(path: Path, flag: str) -> None:
+    """Fail now, with a one-line ConfigError, if ``path`` cannot be written: before the
+    work, not after it.  Makes the missing folders (as the writers would); a file that
+    did not exist is removed again."""
+    existed = path.exists()
+    if path.is_dir():
+        raise ConfigError(f"{flag} {path}: is a folder; give a file name")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("ab"):
+            pass
+    except OSError as exc:
+        raise ConfigError(
+            f"{flag} {path}: cannot write it: {exc.strerror or exc}; give a writable path"
+        ) from None
+    if not existed:
+        path.unlink(missing_ok=True)
 
 
 class ProgressBar:

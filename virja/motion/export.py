@@ -33,6 +33,13 @@ def skeleton_joints() -> list[BvhJoint]:
     return out
 
 
+def bvh_paths(path: str | Path) -> list[Path]:
+    """The files :func:`performance_to_bvh` writes for ``path``: one per figure."""
+    p = Path(path)
+    stem = p.with_suffix("") if p.suffix.lower() == ".bvh" else p
+    return [stem.parent / f"{stem.name}_{fig}.bvh" for fig in FIGURES]
+
+
 def performance_to_bvh(
     animator: BandAnimator, t0: float, t1: float, fps: float, path: str | Path
 ) -> list[Path]:
@@ -46,14 +53,11 @@ def performance_to_bvh(
         raise ValueError(f"end {t1} before start {t0}")
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
     loc = np.stack([animator.local_rotations(t0 + i / fps) for i in range(n)])  # (n, 2, j, 4)
-    p = Path(path)
-    stem = p.with_suffix("") if p.suffix.lower() == ".bvh" else p
     joints = skeleton_joints()
     written = []
-    for fi, fig in enumerate(FIGURES):
+    for fi, (fig, out) in enumerate(zip(FIGURES, bvh_paths(path), strict=True)):
         pos = np.broadcast_to(SKELETON.offsets, (n, SKELETON.n_joints, 3)).copy()
         pos[:, 0] = animator.idle[fig].root_positions[0]
-        out = stem.parent / f"{stem.name}_{fig}.bvh"
         write_bvh(Bvh(joints, 1.0 / fps, loc[:, fi], pos), out)
         written.append(out)
     return written

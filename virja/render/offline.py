@@ -132,6 +132,12 @@ def render_frames(
                 outputs.append(path)
             if progress is not None:
                 progress(i + 1, len(times), time.perf_counter() - started)
+    except KeyboardInterrupt:
+        if writer is not None:
+            writer.abort()
+            writer = None
+            log.warning("interrupted: the unfinished video %s was removed", out.path)
+        raise
     finally:
         if writer is not None:
             writer.close()

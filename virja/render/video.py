@@ -21,7 +21,7 @@ import mido
 import numpy as np
 from numpy.typing import NDArray
 
-from virja.errors import NotAvailableError
+from virja.errors import ConfigError, NotAvailableError
 from virja.events import ControlChange, Event, NoteOff, NoteOn, ProgramChange
 
 log = logging.getLogger(__name__)
@@ -46,10 +46,36 @@ def ffmpeg_exe() -> str:
         raise NotAvailableError(f"no ffmpeg for video output ({exc})") from exc
 
 
+def check_soundfont(path: Path, where: str) -> Path:
+    """``path`` if it is a readable SoundFont 2 file (RIFF ... sfbk), else a one-line
+    ConfigError saying what it is instead."""
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(12)
+    except OSError as exc:
+        raise ConfigError(
+            f"{where} {path}: cannot read it: {exc.strerror or exc}; give a .sf2 SoundFont"
+        ) from None
+    if head[:4] != b"RIFF" or head[8:12] != b"sfbk":
+        raise ConfigError(f"{where} {path}: not a SoundFont 2 file (no RIFF sfbk header)")
+    return path
+
+
 def find_soundfont(explicit: str | None = None) -> Path | None:
-    """The GM soundfont to use: ``explicit``, $VIRJA_SOUNDFONT, or a Debian path."""
-    for cand in (explicit, os.environ.get("VIRJA_SOUNDFONT"), *SOUNDFONT_PATHS):
-        if cand and Path(cand).is_file():
+    """The GM soundfont to use: ``explicit``, $VIRJA_SOUNDFONT, or a Debian path.
+
+    An explicit soundfont that is not one is an error; a $VIRJA_SOUNDFONT that is
+    not one is said in a warning, and the next candidate is used."""
+    if explicit:
+        return check_soundfont(Path(explicit), "--soundfont")
+    env = os.environ.get("VIRJA_SOUNDFONT")
+    if env:
+        try:
+            return check_soundfont(Path(env), "VIRJA_SOUNDFONT")
+        except ConfigError as exc:
+            log.warning("%s; using the default soundfont instead", exc)
+    for cand in SOUNDFONT_PATHS:
+        if Path(cand).is_file():
             return Path(cand)
     return None
 
@@ -189,6 +215,16 @@ class VideoWriter:
             # the last lines say why; keep them whole on one line
             self._err_text = " / ".join(text.splitlines()[-3:])[:500]
         return self._err_text
+
+    def abort(self) -> None:
+        """Stop ffmpeg and remove the unfinished file (an interrupted render)."""
+        self._proc.kill()
+        self._proc.wait()
+        for stream in (self._proc.stdin, self._proc.stderr):
+            if stream is not None:
+                with contextlib.suppress(OSError):
+                    stream.close()
+        self.path.unlink(missing_ok=True)
 
     def close(self) -> None:
         assert self._proc.stdin is not None

@@ -103,7 +103,10 @@ def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> Pe
     events: list[Event] = [*session.events, *session.beats]
     events.sort(key=lambda e: e.time_s)
     n = len(session.tracks)
-    report = [f"{path}: {n} track{'' if n == 1 else 's'}, {session.duration_s:.1f} s", *dry.report()]
+    report = [
+        f"{path}: {n} track{'' if n == 1 else 's'}, {session.duration_s:.1f} s",
+        *dry.report(),
+    ]
     return PerformanceInput(
         kind="midi",
         path=path,

@@ -217,3 +217,20 @@ def test_render_docs_state_the_samples_default() -> None:
     assert "offline renders default to\n`--samples 4`" not in docs
     assert "use no multisampling by default" in " ".join(docs.split())
     assert os.path.exists(DEMO)
+
+
+def test_render_with_the_follow_camera(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    code, out, _ = run(
+        capsys,
+        "render",
+        DEMO,
+        "--out",
+        str(tmp_path / "x.png"),
+        "--at",
+        "9.0",
+        "--size",
+        "64x36",
+        "--camera",
+        "follow",
+    )
+    assert code == 0 and "follow camera:" in out and (tmp_path / "x.png").is_file()

@@ -36,6 +36,8 @@ from virja.render.camera import PRESETS
 
 if TYPE_CHECKING:
     from virja.dance.stage import DancerTrack
+    from virja.render.camera import Camera
+    from virja.render.director import FollowCamera
     from virja.render.renderer import DrawList
 
 log = logging.getLogger(__name__)
@@ -56,7 +58,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--fps", type=finite_float, default=30.0, help="frames per second (default 30)")
     p.add_argument(
-        "--camera", choices=sorted(PRESETS), default="front", help="camera preset (default front)"
+        "--camera",
+        choices=[*sorted(PRESETS), "follow"],
+        default="front",
+        help="camera preset (default front); follow: cuts and moves between the players as "
+        "they play (a drum fill to the drummer, a bass feature to the bassist)",
     )
     p.add_argument(
         "--lookahead-beats",
@@ -218,7 +224,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             fps=args.fps,
             size=size,
             out=out,
-            camera=PRESETS[args.camera],
+            camera=choose_camera(args.camera, src, perf),
             audio=audio,
             audio_offset_s=src.sound_origin_s - t0,
             samples=args.samples,
@@ -245,6 +251,34 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )
     return 0
+
+
+def choose_camera(name: str, src: object, perf: object) -> Camera | FollowCamera:
+    """A preset, or for "follow" the shots planned from the input's band notes (over
+    the whole input, so a single frame with --at shows the shot of that moment)."""
+    from virja.events import NoteOn
+    from virja.input import PerformanceInput
+    from virja.render.director import FollowCamera, plan_shots
+    from virja.routing import Router
+    from virja.session import Performance
+
+    if name != "follow":
+        return PRESETS[name]
+    assert isinstance(src, PerformanceInput) and isinstance(perf, Performance)
+    dry = Router(perf.router.config, perf.router.track_names)  # its own program memory
+    notes = []
+    for reveal in sorted(src.schedule, key=lambda r: r.event.time_s):
+        ev = reveal.event
+        who = dry.route(ev)
+        if who is not None and isinstance(ev, NoteOn):
+            notes.append((ev.time_s, who, ev.note))
+    shots = plan_shots(notes, *src.default_span())
+    print(
+        f"follow camera: {len(shots)} shots: "
+        + ", ".join(f"{s.name} {s.start_s:.1f}-{s.end_s:.1f} s" for s in shots[:8])
+        + (" ..." if len(shots) > 8 else "")
+    )
+    return FollowCamera(shots)
 
 
 def session_dancer(

@@ -68,6 +68,7 @@ class OutputSpec:
 
 
 Progress = Callable[[int, int, float], None]
+CameraAt = Callable[[float], Camera]  # a camera that moves (render.director.FollowCamera)
 
 
 @dataclass
@@ -88,7 +89,7 @@ def render_frames(
     fps: float,
     size: tuple[int, int],
     out: OutputSpec,
-    camera: Camera,
+    camera: Camera | CameraAt,
     audio: Path | None = None,
     audio_offset_s: float = 0.0,
     samples: int = 1,
@@ -123,7 +124,8 @@ def render_frames(
     started = time.perf_counter()
     try:
         for i, t in enumerate(times):
-            renderer.draw(scene_at(t), camera, target.fbo)
+            cam = camera if isinstance(camera, Camera) else camera(t)
+            renderer.draw(scene_at(t), cam, target.fbo)
             if writer is not None:
                 writer.write_raw(target.read_raw_rgb())  # GL row order; ffmpeg flips
             else:
@@ -156,7 +158,7 @@ def render_offline(
     fps: float,
     size: tuple[int, int],
     out: OutputSpec,
-    camera: Camera,
+    camera: Camera | CameraAt,
     audio: Path | None = None,
     audio_offset_s: float = 0.0,
     samples: int = 1,

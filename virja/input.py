@@ -100,7 +100,7 @@ def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> Pe
     session = read_midi(path)
     dry = Router.for_session(session, routing)
     notes = _band_notes(session.events, dry)
-    events: list[Event] = [*session.events, *session.beats]
+    events: list[Event] = [*session.events, *session.beats, *session.chords]
     events.sort(key=lambda e: e.time_s)
     n = len(session.tracks)
     report = [

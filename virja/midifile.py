@@ -27,8 +27,9 @@ from pathlib import Path
 
 import mido
 
+from virja.chords import parse_chord_symbol
 from virja.errors import InputFileError
-from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.events import Beat, Chord, ControlChange, Event, NoteOff, NoteOn, ProgramChange
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, TempoMap
 
 log = logging.getLogger(__name__)
@@ -36,6 +37,8 @@ log = logging.getLogger(__name__)
 DEFAULT_TEMPO_US = 500_000
 # beats generated per file at most: 27.7 hours at 120 bpm, 2.5 MB of Beat objects' worth
 MAX_BEATS = 200_000
+MAX_CHORDS = 100_000  # chord symbols kept per file (a chord a beat for half the beats)
+CHORD_META = frozenset({"lyrics", "marker", "text", "cue_marker"})  # where files put chord symbols
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,7 @@ class MidiSession:
     duration_s: float
     ticks_per_beat: int
     time_signatures: list[tuple[float, int, int]] = field(default_factory=list)
+    chords: list[Chord] = field(default_factory=list)  # chord symbols in lyrics/markers/text
 
     @property
     def notes(self) -> list[NoteOn]:
@@ -139,6 +143,7 @@ def read_midi(path: str | Path) -> MidiSession:
     clock = _TickClock(tempo_changes, mf.ticks_per_beat)
 
     events: list[tuple[int, int, int, Event]] = []  # (tick, track, order, event)
+    chords: list[Chord] = []
     infos: list[TrackInfo] = []
     end_tick = 0
     order = 0
@@ -153,6 +158,10 @@ def read_midi(path: str | Path) -> MidiSession:
             if msg.is_meta:
                 if msg.type == "track_name" and not name:
                     name = str(msg.name).strip()
+                elif msg.type in CHORD_META:
+                    chord = parse_chord_symbol(str(msg.text), clock.to_seconds(tick))
+                    if chord is not None and len(chords) < MAX_CHORDS:
+                        chords.append(chord)
                 continue
             t = clock.to_seconds(tick)
             ev: NoteOn | NoteOff | ControlChange | ProgramChange | None = None
@@ -198,6 +207,7 @@ def read_midi(path: str | Path) -> MidiSession:
         events=[e for *_, e in events],
         tempo_map=tempo_map,
         beats=beats,
+        chords=sorted(chords, key=lambda c: c.time_s),
         tracks=infos,
         duration_s=duration,
         ticks_per_beat=mf.ticks_per_beat,

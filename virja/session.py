@@ -21,7 +21,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import IO, TYPE_CHECKING
 
-from virja.events import Beat, Event, NoteOff, NoteOn, Performer
+from virja.events import Beat, Chord, Event, NoteOff, NoteOn, Performer
+from virja.hud import HudTimeline
 from virja.routing import Router
 from virja.tempo import Tempo
 
@@ -52,11 +53,15 @@ class Performance:
         self.counts: Counter[str] = Counter()
         self.planned: list[PlannedNote] = []
         self.keep_planned = True
+        self.hud = HudTimeline()  # tempo, bar.beat and chord for the heads-up display
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""
         if isinstance(event, Beat):
             self._beat(event)
+            return None
+        if isinstance(event, Chord):
+            self.hud.add(event)
             return None
         performer = self.router.route(event)
         if performer is not None:
@@ -82,6 +87,7 @@ class Performance:
             self._beat(event)
 
     def _beat(self, beat: Beat) -> None:
+        self.hud.add(beat)
         self.planner.add_beat(beat)
         if self.animator is not None:
             self.animator.add_beat(beat)

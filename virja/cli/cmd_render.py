@@ -73,6 +73,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--no-audio", action="store_true", help="make a silent video")
     p.add_argument(
+        "--hud",
+        action="store_true",
+        help="draw a heads-up display: tempo, bar.beat and chord (from BEAT and CHORD "
+        "messages, a file's tempo map, and chord symbols in its lyrics or markers)",
+    )
+    p.add_argument(
         "--soundfont", metavar="FILE.sf2", help="General MIDI soundfont for the audio track"
     )
     p.add_argument(
@@ -230,6 +236,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             samples=args.samples,
             progress=progress,
             extra=extra,
+            hud=getattr(args, "hud", False),
         )
     if plan_log is not None:
         plan_log.close()

@@ -19,6 +19,7 @@ from pathlib import Path
 from virja.errors import ConfigError
 from virja.render.camera import Camera
 from virja.render.hosts import OffscreenTarget, create_headless_context
+from virja.render.hud import HudOverlay
 from virja.render.images import write_png
 from virja.render.renderer import DrawList, Renderer
 from virja.render.scene import band_scene, static_scene
@@ -69,6 +70,7 @@ class OutputSpec:
 
 Progress = Callable[[int, int, float], None]
 CameraAt = Callable[[float], Camera]  # a camera that moves (render.director.FollowCamera)
+TextAt = Callable[[float], str]  # the heads-up display's line at a frame time
 
 
 @dataclass
@@ -94,6 +96,7 @@ def render_frames(
     audio_offset_s: float = 0.0,
     samples: int = 1,
     progress: Progress | None = None,
+    hud: TextAt | None = None,
 ) -> tuple[float, list[Path]]:
     """Draw ``scene_at(t)`` for each frame time and write it to ``out``.
 
@@ -105,6 +108,7 @@ def render_frames(
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     target = OffscreenTarget(ctx, size, samples=samples)
+    overlay = HudOverlay(ctx) if hud is not None else None
     writer: VideoWriter | None = None
     outputs: list[Path] = []
     folder = out.path if out.kind == "folder" else out.path.parent
@@ -126,6 +130,8 @@ def render_frames(
         for i, t in enumerate(times):
             cam = camera if isinstance(camera, Camera) else camera(t)
             renderer.draw(scene_at(t), cam, target.fbo)
+            if overlay is not None and hud is not None:
+                overlay.draw(target.fbo, hud(t))
             if writer is not None:
                 writer.write_raw(target.read_raw_rgb())  # GL row order; ffmpeg flips
             else:
@@ -144,6 +150,8 @@ def render_frames(
         if writer is not None:
             writer.close()
         target.release()
+        if overlay is not None:
+            overlay.release()
         renderer.release()
         ctx.release()
     return time.perf_counter() - started, outputs
@@ -164,6 +172,7 @@ def render_offline(
     samples: int = 1,
     progress: Progress | None = None,
     extra: SceneAt | None = None,
+    hud: bool = False,
 ) -> RenderResult:
     """Drive ``perf`` from t0 to t1 at ``fps`` and write each frame to ``out``.
 
@@ -189,6 +198,7 @@ def render_offline(
         audio_offset_s=audio_offset_s,
         samples=samples,
         progress=progress,
+        hud=(lambda t: perf.hud.at(t).text()) if hud else None,
     )
     feeder.until(perf, math.inf)
     perf.finish()

@@ -14,9 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from virja.errors import InputFileError
-from virja.events import Event, NoteOff, NoteOn
+from virja.events import Event, NoteOff, NoteOn, Performer
 from virja.midifile import MidiSession, read_midi
 from virja.routing import Router, RoutingConfig
+from virja.routing_hints import routing_hints
 from virja.session import Reveal, reveal_schedule
 from virja.tempo import Tempo
 
@@ -48,15 +49,29 @@ class PerformanceInput:
         return (start, last_event + TAIL_S)
 
 
-def _band_notes(events: Iterable[Event], router: Router) -> int:
-    """How many note-ons the band plays.  Every event goes through the router, so
-    program changes take effect for the notes after them."""
-    n = 0
+def _routed_notes(events: Iterable[Event], router: Router) -> list[tuple[NoteOn, Performer | None]]:
+    """Each note-on with the performer it goes to.  Every event goes through the
+    router, so program changes take effect for the notes after them."""
+    out: list[tuple[NoteOn, Performer | None]] = []
     for ev in events:
         who = router.route(ev)
-        if who is not None and isinstance(ev, NoteOn):
-            n += 1
-    return n
+        if isinstance(ev, NoteOn):
+            out.append((ev, who))
+    return out
+
+
+def nothing_for_the_band(path: Path, report: list[str]) -> InputFileError:
+    """The error for an input the band plays nothing of, with the routing hints."""
+    hints = [line.removeprefix("hint: ") for line in report if line.startswith("hint: ")]
+    advice = (
+        f"; {hints[0]}"
+        if hints
+        else (
+            "; if a part is the bass or the drums, route it with --bass-channel N, "
+            "--drums-channel N or --bass-track NAME (docs/routing.md)"
+        )
+    )
+    return InputFileError(path, "no notes for the band (bass or drums) in this input" + advice)
 
 
 def input_kind(path: Path) -> str:
@@ -99,13 +114,15 @@ def load_performance_input(
 def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> PerformanceInput:
     session = read_midi(path)
     dry = Router.for_session(session, routing)
-    notes = _band_notes(session.events, dry)
+    routed = _routed_notes(session.events, dry)
+    notes = sum(1 for _note, who in routed if who is not None)
     events: list[Event] = [*session.events, *session.beats, *session.chords]
     events.sort(key=lambda e: e.time_s)
     n = len(session.tracks)
     report = [
         f"{path}: {n} track{'' if n == 1 else 's'}, {session.duration_s:.1f} s",
         *dry.report(),
+        *routing_hints(routed, dry.track_names),
     ]
     return PerformanceInput(
         kind="midi",
@@ -137,7 +154,8 @@ def pcap_input(
         for rec in receiver.drain_events():
             schedule.append(Reveal(rec.arrival_s, rec.event))
     dry = Router(routing)
-    notes = _band_notes((r.event for r in schedule), dry)
+    routed = _routed_notes((r.event for r in schedule), dry)
+    notes = sum(1 for _note, who in routed if who is not None)
     sound = sorted(
         (r.event for r in schedule if isinstance(r.event, NoteOn | NoteOff)), key=lambda e: e.time_s
     )
@@ -149,6 +167,7 @@ def pcap_input(
         f"{path}: {cap.packets} packets, {len(cap.datagrams)} RMCP datagrams, "
         f"{stats['events']} events accepted, drops {stats['dropped'] or 'none'}",
         *dry.report(),
+        *routing_hints(routed, {}),
     ]
     return PerformanceInput(
         kind="pcap",

@@ -56,7 +56,10 @@ def test_table_and_summary_report_moved_notes(
     song = _song(tmp_path / "song.mid")
     assert main(["plan", str(song)]) == 0
     out = capsys.readouterr().out
-    assert out.splitlines()[0].split()[:3] == ["time", "performer", "note"]
+    lines = out.splitlines()
+    assert lines[0].startswith(f"{song}: ") and "-> drummer" in out  # the routing report first
+    header = next(line for line in lines if line.startswith("time"))
+    assert header.split()[:3] == ["time", "performer", "note"]
     assert "bass: 3 notes planned" in out
     assert "drums: 6 notes planned" in out
     assert "moved by octaves: 1; 16 -> 28" in out

@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from virja.cli.common import finite_float
+from virja.cli.common import add_routing_arguments, finite_float, routing_config
 from virja.errors import ConfigError
 from virja.events import NoteOn
+from virja.input import PerformanceInput, nothing_for_the_band
 from virja.plan.types import PlannedNote, PlanReport
 
 PCAP_SUFFIXES = {".pcap", ".pcapng", ".cap"}
@@ -37,26 +39,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="B",
         help="MIDI files: each note is known B beats before it sounds (default 1)",
     )
-    parser.add_argument("--config", default=None, metavar="FILE.toml", help="[plan] and [routing]")
     parser.add_argument(
         "--port", type=int, default=None, metavar="N", help="pcap: the RMCP UDP port"
     )
+    add_routing_arguments(parser)
 
 
 def _plan_midi(
     path: Path, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
-    from virja.config import section
     from virja.midifile import read_midi
     from virja.plan import load_plan_config, plan_notes_with_report
-    from virja.routing import Router, RoutingConfig, route_all
+    from virja.routing import Router, route_all
 
     session = read_midi(path)
     router = Router.for_session(
         session,
-        RoutingConfig.from_dict(
-            section(doc, "routing"), f"{args.config} [routing]" if args.config else "[routing]"
-        ),
+        routing_config(args, doc),
     )
     notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
     return plan_notes_with_report(
@@ -68,22 +67,26 @@ def _plan_midi(
 
 
 def _plan_pcap(
-    path: Path, args: argparse.Namespace, doc: dict[str, Any]
+    src: PerformanceInput, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
     """A recording through the live receiver and planner on its recorded clock."""
-    from virja.config import section
-    from virja.input import pcap_input
     from virja.plan import OnlinePlanner, load_plan_config
-    from virja.routing import Router, RoutingConfig
+    from virja.routing import Router
     from virja.session import Performance, run_schedule
 
-    routing = RoutingConfig.from_dict(
-        section(doc, "routing"), f"{args.config} [routing]" if args.config else "[routing]"
-    )
-    src = pcap_input(path, routing, port=args.port)
+    routing = routing_config(args, doc)
     planner = OnlinePlanner(load_plan_config(args.config))
     perf = Performance(router=Router(routing), planner=planner)
     return run_schedule(perf, src.schedule), planner.report
+
+
+def _input(path: Path, args: argparse.Namespace, doc: dict[str, Any]) -> PerformanceInput:
+    from virja.input import load_performance_input
+
+    routing = routing_config(args, doc)
+    return load_performance_input(
+        path, routing, lookahead_beats=args.lookahead_beats, port=args.port
+    )
 
 
 def _fmt(value: object) -> str:
@@ -135,8 +138,16 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--lookahead-beats must be >= 0")
     path = Path(args.input)
     doc = load_config(args.config)
-    is_pcap = path.suffix.lower() in PCAP_SUFFIXES
-    planned, report = (_plan_pcap if is_pcap else _plan_midi)(path, args, doc)
+    src = _input(path, args, doc)
+    # where each track went, and hints when the band got nothing: on stderr with --json
+    for line in src.report:
+        print(line, file=sys.stderr if args.json else sys.stdout)
+    if src.note_count == 0:
+        raise nothing_for_the_band(path, src.report)
+    if src.kind == "pcap":
+        planned, report = _plan_pcap(src, args, doc)
+    else:
+        planned, report = _plan_midi(path, args, doc)
     if args.json:
         try:
             for p in planned:

@@ -31,7 +31,7 @@ from virja.cli.common import (
     open_plan_log,
     routing_config,
 )
-from virja.errors import ConfigError, InputFileError
+from virja.errors import ConfigError
 from virja.render.camera import PRESETS
 
 if TYPE_CHECKING:
@@ -127,7 +127,7 @@ def add_dancer_argument(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from virja.input import load_performance_input
+    from virja.input import load_performance_input, nothing_for_the_band
 
     if args.fps <= 0 or args.fps > 240:
         raise ConfigError(f"--fps must be in (0, 240], got {args.fps}")
@@ -146,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     for line in src.report:
         print(line)
     if src.note_count == 0:
-        raise InputFileError(args.input, "no notes for the band (bass or drums) in this input")
+        raise nothing_for_the_band(Path(args.input), src.report)
     return render_input(src, args, size, out)
 
 

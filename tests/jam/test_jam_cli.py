@@ -34,11 +34,21 @@ def test_unknown_config_keys_are_refused() -> None:
 
 @pytest.mark.parametrize(
     ("table", "match"),
-    [({"delay_ms": -5}, "delay_ms"), ({"split": "C3"}, "split"), ({"api": "coreaudio"}, "api")],
-)
+    [({"delay_ms": -5}, "delay_ms"), ({"split": "H3"}, "split"), ({"split": 128}, "split"),
+     ({"split": True}, "split"), ({"api": "coreaudio"}, "api")],
+)  # fmt: skip
 def test_bad_option_values_are_config_errors(table: dict[str, object], match: str) -> None:
     with pytest.raises(ConfigError, match=match):
         JamOptions.merge(table, {})
+
+
+@pytest.mark.parametrize(
+    ("value", "key"), [("C3", 48), ("48", 48), (48, 48), ("Bb2", 46), ("F#3", 54), ("c4", 60)]
+)
+def test_the_split_is_a_key_name_or_number(value: object, key: int) -> None:
+    """The help and the docs name the split as C3: the flag and the config take it so."""
+    assert JamOptions.merge({}, {"split": value}).split == key
+    assert JamOptions.merge({"split": value}, {}).split == key
 
 
 def test_help_names_the_latency_option(capsys: pytest.CaptureFixture[str]) -> None:

@@ -19,8 +19,8 @@ from pathlib import Path, PurePosixPath
 
 from virja.batch.jobs import Job, OutputKind
 from virja.batch.manifest import JobResult, Status
-from virja.errors import InputFileError, VirjaError
-from virja.input import PerformanceInput, load_performance_input
+from virja.errors import VirjaError
+from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
 from virja.plan.config import PlanConfig
 from virja.routing import Router, RoutingConfig
 from virja.session import Performance, RevealFeeder, frame_times, run_schedule
@@ -132,7 +132,7 @@ def run_job(job: Job, data: bytes, settings: BatchSettings) -> JobResult:
                 src_path, settings.routing, lookahead_beats=settings.lookahead_beats
             )
             if src.note_count == 0:
-                raise InputFileError(src_path, "no notes for the band (bass or drums)")
+                raise nothing_for_the_band(src_path, src.report)
             files: dict[str, bytes] = {}
             for kind in job.kinds:
                 out = Path(tmp) / kind.value

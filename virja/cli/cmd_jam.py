@@ -53,10 +53,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--list-ports", action="store_true", help="list MIDI ports and exit")
     parser.add_argument(
         "--split",
-        type=int,
         default=None,
         metavar="KEY",
-        help="lowest key of the upper part; keys below it play the bass (default 48, C3)",
+        help="lowest key of the upper part, a name or a MIDI number (C3, Bb2, 48); "
+        "keys below it play the bass (default C3 = 48)",
     )
     parser.add_argument(
         "--upper",

@@ -4,7 +4,7 @@
 [jam]
 api = "jack"          # "jack" | "alsa"; absent: the first that works here
 port = "Keystation"   # connect to the first source whose name contains this
-split = 48            # lowest key of the pianist's part (C3); below it: the bassist
+split = "C3"          # lowest key of the pianist's part (or 48); below it: the bassist
 upper = "ignore"      # "ignore" | "drums": the upper keys play the drummer
 delay_ms = 0          # put sound (thru) and picture off by this much
 thru = "fluidsynth"   # forward notes to the first synth port whose name contains this
@@ -15,6 +15,7 @@ fps = 60              # frames per second of the loop (headless: the planner's t
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -26,6 +27,25 @@ from virja.jam.ports import API_NAMES
 MAX_DELAY_MS = 2000.0  # more than two seconds is not a jam any more; a typo, most likely
 
 _KEYS = ("api", "port", "split", "upper", "delay_ms", "thru", "send", "fps")
+_KEY_NAME = re.compile(r"^([A-Ga-g])([#b]?)(-?\d)$")
+_PITCH = {"c": 0, "d": 2, "e": 4, "f": 5, "g": 7, "a": 9, "b": 11}
+
+
+def parse_key(value: object) -> int:
+    """A key as a MIDI number (48) or a name with its octave, middle C being C4 ("C3" is
+    48, "Bb2" 46, "F#3" 54); a ConfigError for anything else or outside 0-127."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        key = value
+    elif isinstance(value, str) and value.strip().lstrip("-").isdigit():
+        key = int(value)
+    elif isinstance(value, str) and (m := _KEY_NAME.match(value.strip())):
+        letter, accidental, octave = m.groups()
+        key = 12 * (int(octave) + 1) + _PITCH[letter.lower()] + {"#": 1, "b": -1, "": 0}[accidental]
+    else:
+        raise ConfigError(f"split: {value!r} is not a key; give a MIDI number (48) or a name (C3)")
+    if not 0 <= key <= 127:
+        raise ConfigError(f"split: {value!r} is outside the MIDI keys 0-127")
+    return key
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,7 +86,9 @@ class JamOptions:
             raise ConfigError(f"[jam]: unknown key(s) {', '.join(unknown)}; known: {_KEYS}")
         values: dict[str, Any] = dict(table)
         values.update({k: v for k, v in overrides.items() if k in _KEYS and v is not None})
-        for key, typ in (("split", int), ("delay_ms", (int, float)), ("fps", (int, float))):
+        if "split" in values:
+            values["split"] = parse_key(values["split"])
+        for key, typ in (("delay_ms", (int, float)), ("fps", (int, float))):
             if key in values and (
                 not isinstance(values[key], typ) or isinstance(values[key], bool)
             ):

@@ -45,7 +45,7 @@ def performance_to_bvh(
     if t1 < t0:
         raise ValueError(f"end {t1} before start {t0}")
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
-    loc = np.stack([animator.local_rotations(t0 + i / fps) for i in range(n)])  # (n, 2, j, 4)
+    loc = animator.local_rotations_many(t0 + np.arange(n) / fps)  # (n, 2, j, 4), batched
     p = Path(path)
     stem = p.with_suffix("") if p.suffix.lower() == ".bvh" else p
     joints = skeleton_joints()

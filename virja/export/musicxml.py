@@ -364,9 +364,9 @@ def _bass_part(root: ET.Element, s: Score) -> None:
                     _sub(st, "tuning-alter", str(ALTERS[wt % 12]))
                 _sub(st, "tuning-octave", str(wt // 12 - 1))
             tr = _sub(a, "transpose")
-            _sub(tr, "diatonic", "-7")
-            _sub(tr, "chromatic", "-12")
-            _sub(tr, "octave-change", "-1")
+            _sub(tr, "diatonic", "0")
+            _sub(tr, "chromatic", "0")
+            _sub(tr, "octave-change", "-1")  # sounding = written an octave lower
         prev = (meas[2], meas[3])
         if k in s.tempos:
             _tempo(m, s.tempos[k])

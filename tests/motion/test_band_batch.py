@@ -61,3 +61,35 @@ def test_batched_poses_equal_pose() -> None:
 def test_batched_sampling_wants_sorted_times() -> None:
     with pytest.raises(ValueError, match="sorted"):
         BandAnimator().local_rotations_many(np.array([1.0, 0.5]))
+
+
+def _align_signs_loop(frames: np.ndarray) -> np.ndarray:
+    out = frames.copy()
+    for k in range(1, out.shape[0]):
+        flip = np.sum(out[k] * out[k - 1], axis=-1) < 0
+        out[k, flip] *= -1.0
+    return out
+
+
+def test_vectorised_align_signs_equals_the_frame_loop() -> None:
+    from virja.motion.clip import align_signs
+
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=(60, 9, 4))
+    assert np.array_equal(align_signs(q), _align_signs_loop(q))
+    q[10, 3] = 0.0  # a zero dot product: the sign restarts, as in the loop
+    assert np.array_equal(align_signs(q), _align_signs_loop(q))
+
+
+def test_sticks_of_many_frames_equal_one_at_a_time() -> None:
+    from virja.motion.band import sticks
+
+    animator, (t0, _) = _animate(DEMO_MID)
+    times = t0 + np.arange(0, 200, 13) / 30
+    loc = animator.local_rotations_many(times)
+    from virja.motion.skeleton import SKELETON
+
+    wpos, wrot = SKELETON.fk(loc[:, 0], animator.idle["drums"].root_positions[0])
+    many = sticks(wpos, wrot)
+    for k in range(len(times)):
+        assert np.array_equal(many[k], sticks(wpos[k], wrot[k]))

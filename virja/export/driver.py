@@ -95,9 +95,11 @@ def check_request(
         _check_out(musicxml, "--musicxml", (".musicxml", ".xml"))
 
 
-def sample(animator: BandAnimator, times: np.ndarray) -> Sampled:
-    """The band at ``times`` (sorted), as arrays for the glTF writer."""
-    local = animator.local_rotations_many(times)
+def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None = None) -> Sampled:
+    """The band at ``times`` (sorted), as arrays for the glTF writer (``local``: the
+    animator's ``local_rotations_many(times)`` if the caller has it)."""
+    if local is None:
+        local = animator.local_rotations_many(times)
     poses = animator.poses(times, local)
     kick = GEOMETRY.kit.kick_pedal
     up_y, down_y = float(kick.toe_point(False)[1]), float(kick.toe_point(True)[1])
@@ -196,10 +198,11 @@ def export_performance(
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
     times = t0 + np.arange(n) / fps
     outputs: list[Path] = []
+    local = animator.local_rotations_many(times) if (g or b) else None
     if g is not None:
-        outputs += write_gltf(sample(animator, times), g)
+        outputs += write_gltf(sample(animator, times, local), g)
     if b is not None:
-        outputs += performance_to_bvh(animator, t0, t1, fps, b)
+        outputs += performance_to_bvh(animator, t0, t1, fps, b, local)
     if m is not None:
         outputs.append(write_musicxml(score_of(src, planned, plan_config, t0, t1), m))
     return Export(outputs, planned, t0, t1, n, list(src.report))

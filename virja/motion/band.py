@@ -375,6 +375,7 @@ class BandAnimator:
         ts = np.asarray(times, dtype=np.float64)
         loc = self.local_rotations_many(ts) if local is None else local
         wpos, wrot = _SK.fk(loc, self._roots)
+        all_sticks = sticks(wpos[:, 0], wrot[:, 0])
         out = []
         for k, t in enumerate(ts.tolist()):
             p, r = wpos[k], wrot[k]
@@ -384,7 +385,7 @@ class BandAnimator:
                     time_s=t,
                     drums=figs[0],
                     bass=figs[1],
-                    sticks=sticks(p[0], r[0]),
+                    sticks=all_sticks[k],
                     hihat_open=self._hihat_open(p[0]),
                     cymbal_swing=self._swings(t),
                     head_hits=self._head_hits(t),
@@ -456,13 +457,14 @@ class BandAnimator:
 
 
 def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:
-    """(2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result."""
-    out = np.empty((2, 2, 3))
+    """(..., 2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result
+    (``wpos`` (..., n, 3), ``wrot`` (..., n, 4): one frame or many)."""
+    out = np.empty(wpos.shape[:-2] + (2, 2, 3))
     for i, side in enumerate(("Left", "Right")):
-        grip = wpos[_SK.index(f"{side}HandEnd")]
-        axis = quat.rotate(wrot[_SK.index(f"{side}Hand")], STICK_AXIS_LOCAL)
-        out[i, 0] = grip - STICK_BUTT_M * axis
-        out[i, 1] = grip + STICK_TIP_M * axis
+        grip = wpos[..., _SK.index(f"{side}HandEnd"), :]
+        axis = quat.rotate(wrot[..., _SK.index(f"{side}Hand"), :], STICK_AXIS_LOCAL)
+        out[..., i, 0, :] = grip - STICK_BUTT_M * axis
+        out[..., i, 1, :] = grip + STICK_TIP_M * axis
     return out
 
 

@@ -387,9 +387,9 @@ def format_bvh(bvh: Bvh, decimals: int = 4) -> str:
     out.append("MOTION")
     out.append(f"Frames: {bvh.n_frames}")
     out.append(f"Frame Time: {bvh.frame_time_s:.8f}")
-    fmt = f"{{:.{decimals}f}}"
-    for row in data:
-        out.append(" ".join(fmt.format(x) for x in row))
+    # one %-format per row (the same digits as formatting each number alone, several times faster)
+    row_fmt = " ".join([f"%.{decimals}f"] * data.shape[1])
+    out.extend(row_fmt % tuple(row) for row in data.tolist())
     return "\n".join(out) + "\n"
 
 

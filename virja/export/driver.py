@@ -184,7 +184,9 @@ def export_performance(
     src = load_performance_input(src_path, routing, lookahead_beats=lookahead_beats)
     if src.note_count == 0:
         raise InputFileError(src_path, "no notes for the band (bass or drums) in this input")
-    animator = BandAnimator()
+    # notation needs only the plan: MusicXML alone skips the animator (so a tuning the
+    # bassist's clips do not cover yet still gets its tablature)
+    animator = BandAnimator() if (g or b) else None
     router = Router.for_session(src.midi, routing) if src.midi is not None else Router(routing)
     perf = Performance(
         router=router, planner=OnlinePlanner(plan_config, tempo=src.tempo), animator=animator
@@ -198,11 +200,12 @@ def export_performance(
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
     times = t0 + np.arange(n) / fps
     outputs: list[Path] = []
-    local = animator.local_rotations_many(times) if (g or b) else None
-    if g is not None:
-        outputs += write_gltf(sample(animator, times, local), g)
-    if b is not None:
-        outputs += performance_to_bvh(animator, t0, t1, fps, b, local)
+    if animator is not None:
+        local = animator.local_rotations_many(times)
+        if g is not None:
+            outputs += write_gltf(sample(animator, times, local), g)
+        if b is not None:
+            outputs += performance_to_bvh(animator, t0, t1, fps, b, local)
     if m is not None:
         outputs.append(write_musicxml(score_of(src, planned, plan_config, t0, t1), m))
     return Export(outputs, planned, t0, t1, n, list(src.report))

@@ -142,3 +142,26 @@ def test_gmd_takes_export_valid_gltf_with_separate_buffer(take: str, tmp_path: P
         if c["target"]["node"] == hihat
     }
     assert paths == {"rotation", "translation"}  # swings and rises with the pedal
+
+
+def test_instrument_parts_move(demo_export: Export) -> None:
+    """Pedals, cymbals, the hi-hat and the strings have channels whose values change."""
+    glb = next(p for p in demo_export.outputs if p.suffix == ".glb")
+    doc = pygltflib.GLTF2().load(str(glb))
+    names = {i: n.name for i, n in enumerate(doc.nodes)}
+    moving: dict[str, float] = {}
+    for a in doc.animations:
+        for ch in a.channels:
+            values = _frames(doc, a.samplers[ch.sampler].output)
+            spread = float(np.max(values.max(axis=0) - values.min(axis=0)))
+            moving[f"{names[ch.target.node]}.{ch.target.path}"] = spread
+    for key in (
+        "kit_pedal_kick.rotation",
+        "kit_pedal_hihat.rotation",
+        "kit_crash.rotation",
+        "kit_ride.rotation",
+        "kit_hihat.translation",
+        "bass_string_E.weights",
+        "bass_string_G.weights",
+    ):
+        assert moving[key] > 1e-3, key

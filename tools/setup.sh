@@ -35,3 +35,19 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
   .venv/bin/python -m pip install -q -e '.[test,ray]'
   touch "$stamp"
 fi
+
+# Node tools the tests run (tools/node/package.json, pinned by its package-lock.json):
+# the Khronos glTF Validator checks `virja export --gltf` output.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "setup: installing nodejs and npm"
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+fi
+node_stamp=tools/node/node_modules/.virja-installed
+if [ ! -f "$node_stamp" ] || [ tools/node/package-lock.json -nt "$node_stamp" ]; then
+  echo "setup: installing the node test tools into tools/node/node_modules"
+  (cd tools/node && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  touch "$node_stamp"
+fi

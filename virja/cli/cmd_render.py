@@ -110,7 +110,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--plan-log", metavar="FILE.jsonl", help="also write the plan, one JSON object per note"
     )
     p.add_argument(
-        "--bvh", metavar="OUT.bvh", help="also export the band's performed motion as BVH"
+        "--bvh",
+        metavar="OUT.bvh",
+        help="also write the band's performed motion as OUT_drums.bvh and OUT_bass.bvh "
+        "(one per figure; `virja export` does it without rendering)",
     )
     add_dancer_argument(p)
     add_routing_arguments(p)

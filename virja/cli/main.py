@@ -26,6 +26,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "plan": ("virja.cli.cmd_plan", "print the basic motions the scheduler picks for each note"),
     "render": ("virja.cli.cmd_render", "render a MIDI file or a recording to PNG frames or video"),
+    "export": (
+        "virja.cli.cmd_export",
+        "export a performance as glTF, BVH and MusicXML (no rendering)",
+    ),
     "replay": ("virja.cli.cmd_replay", "replay a pcap recording of RMCP traffic"),
     "jam": ("virja.cli.cmd_jam", "play a MIDI keyboard, the band plays what you play"),
     "batch": (

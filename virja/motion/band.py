@@ -33,7 +33,7 @@ from virja.motion.skeleton import (
     STICK_BUTT_M,
     STICK_TIP_M,
 )
-from virja.motion.timeline import Instance, Timeline
+from virja.motion.timeline import Instance, Timeline, blend_many
 
 log = logging.getLogger(__name__)
 
@@ -323,6 +323,80 @@ class BandAnimator:
             plucking_tip=wpos[1, _SK.index("RightHandEnd")].copy(),
         )
 
+    def local_rotations_many(self, times: np.ndarray) -> np.ndarray:
+        """:meth:`local_rotations` at many times at once: (m, 2, n_joints, 4).
+
+        ``times`` (m,) must be sorted ascending.  Vectorised over times (one
+        numpy pass per clip instance, not per frame) for exports; equal to
+        ``local_rotations(t)`` for each ``t`` to rounding (tests/motion/test_band.py).
+        """
+        ts = np.asarray(times, dtype=np.float64)
+        if ts.ndim != 1 or (ts.size > 1 and np.any(np.diff(ts) < 0)):
+            raise ValueError("times must be a 1-D array sorted ascending")
+        out = np.empty((ts.size, 2, _SK.n_joints, 4))
+        nod = self._nod_many(ts)
+        for fi, f in enumerate(FIGURES):
+            loc = out[:, fi]
+            loc[:] = self.idle[f].rotations[0]
+            loc[:, _NECK] = quat.multiply(loc[:, _NECK], nod[:, 0])
+            loc[:, _HEAD] = quat.multiply(loc[:, _HEAD], nod[:, 1])
+            for limb in FIGURE_LIMBS[f]:
+                tl = self.timelines[(f, limb)]
+                if len(tl):
+                    loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
+        return out
+
+    def _nod_many(self, t: np.ndarray) -> np.ndarray:
+        """:meth:`_nod` over an array of times: (m, 2, 4)."""
+        s = self.settings
+        bt = np.asarray(self._beat_times, dtype=np.float64)
+        i = np.searchsorted(bt, t, side="right") - 1
+        if bt.size:
+            k = np.maximum(i, 0)
+            spb = np.asarray(self._beat_spb, dtype=np.float64)
+            beat_phase = np.minimum((t - bt[k]) / spb[k], 1.0)
+        else:
+            beat_phase = np.zeros_like(t)
+        phase = np.where(i >= 0, beat_phase, np.mod(t / s.reference_spb, 1.0))
+        nod = s.nod_rad * np.sin(np.pi * phase) ** 2
+        sway = s.sway_rad * np.sin(2 * np.pi * t / s.sway_period_s)
+        out = np.zeros((t.size, 2, 4))
+        out[:, 0, 0] = np.cos(nod / 2)
+        out[:, 0, 1] = np.sin(nod / 2)
+        out[:, 1, 0] = np.cos(sway / 2)
+        out[:, 1, 2] = np.sin(sway / 2)
+        return out
+
+    def poses(self, times: np.ndarray, local: np.ndarray | None = None) -> list[BandPose]:
+        """:meth:`pose` at many times (sorted ascending), FK batched over all of them.
+
+        ``local`` is :meth:`local_rotations_many` of ``times`` if the caller has it.
+        """
+        ts = np.asarray(times, dtype=np.float64)
+        loc = self.local_rotations_many(ts) if local is None else local
+        wpos, wrot = _SK.fk(loc, self._roots)
+        all_sticks = sticks(wpos[:, 0], wrot[:, 0])
+        out = []
+        for k, t in enumerate(ts.tolist()):
+            p, r = wpos[k], wrot[k]
+            figs = [FigurePose(_SK.names, _SK.parents, p[i], r[i], _SK.radii) for i in range(2)]
+            out.append(
+                BandPose(
+                    time_s=t,
+                    drums=figs[0],
+                    bass=figs[1],
+                    sticks=all_sticks[k],
+                    hihat_open=self._hihat_open(p[0]),
+                    cymbal_swing=self._swings(t),
+                    head_hits=self._head_hits(t),
+                    string_vibration=self._strings(t),
+                    string_stops=self._stops(t),
+                    fretting_tip=p[1, _SK.index("LeftHandEnd")].copy(),
+                    plucking_tip=p[1, _SK.index("RightHandEnd")].copy(),
+                )
+            )
+        return out
+
     def _recent(self, t: float, window: float) -> list[Hit]:
         lo = bisect.bisect_left(self._hit_times, t - window)
         hi = bisect.bisect_right(self._hit_times, t)
@@ -383,13 +457,14 @@ class BandAnimator:
 
 
 def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:
-    """(2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result."""
-    out = np.empty((2, 2, 3))
+    """(..., 2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result
+    (``wpos`` (..., n, 3), ``wrot`` (..., n, 4): one frame or many)."""
+    out = np.empty(wpos.shape[:-2] + (2, 2, 3))
     for i, side in enumerate(("Left", "Right")):
-        grip = wpos[_SK.index(f"{side}HandEnd")]
-        axis = quat.rotate(wrot[_SK.index(f"{side}Hand")], STICK_AXIS_LOCAL)
-        out[i, 0] = grip - STICK_BUTT_M * axis
-        out[i, 1] = grip + STICK_TIP_M * axis
+        grip = wpos[..., _SK.index(f"{side}HandEnd"), :]
+        axis = quat.rotate(wrot[..., _SK.index(f"{side}Hand"), :], STICK_AXIS_LOCAL)
+        out[..., i, 0, :] = grip - STICK_BUTT_M * axis
+        out[..., i, 1, :] = grip + STICK_TIP_M * axis
     return out
 
 

@@ -120,9 +120,19 @@ def sample_frames(
 def align_signs(frames: np.ndarray) -> np.ndarray:
     """``frames`` (n, j, 4) with each quaternion's sign flipped to agree with the previous frame."""
     out = frames.copy()
-    for k in range(1, out.shape[0]):
-        flip = np.sum(out[k] * out[k - 1], axis=-1) < 0
-        out[k, flip] *= -1.0
+    if out.shape[0] < 2:
+        return out
+    # frame k's sign is frame k-1's times the sign of their dot product, a running
+    # product (flipping a quaternion negates its dot products exactly); a dot of
+    # exactly 0 restarts the sign at +1, so such a rare clip takes the plain loop
+    d = np.sum(out[1:] * out[:-1], axis=-1)
+    if np.any(d == 0):
+        for k in range(1, out.shape[0]):
+            flip = np.sum(out[k] * out[k - 1], axis=-1) < 0
+            out[k, flip] *= -1.0
+        return out
+    sign = np.cumprod(np.where(d < 0, -1.0, 1.0), axis=0)
+    out[1:] *= sign[..., None]
     return out
 
 

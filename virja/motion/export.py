@@ -41,18 +41,27 @@ def bvh_paths(path: str | Path) -> list[Path]:
 
 
 def performance_to_bvh(
-    animator: BandAnimator, t0: float, t1: float, fps: float, path: str | Path
+    animator: BandAnimator,
+    t0: float,
+    t1: float,
+    fps: float,
+    path: str | Path,
+    local: np.ndarray | None = None,
 ) -> list[Path]:
     """Sample [t0, t1] at ``fps`` and write ``<stem>_drums.bvh`` and ``<stem>_bass.bvh``.
 
-    Returns the paths written.  ``path`` may end in ``.bvh`` or not.
+    Returns the paths written.  ``path`` may end in ``.bvh`` or not.  ``local``:
+    the animator's ``local_rotations_many`` of exactly those frame times, if the
+    caller has them already.
     """
     if not fps > 0:
         raise ValueError(f"fps must be > 0, got {fps}")
     if t1 < t0:
         raise ValueError(f"end {t1} before start {t0}")
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
-    loc = np.stack([animator.local_rotations(t0 + i / fps) for i in range(n)])  # (n, 2, j, 4)
+    loc = animator.local_rotations_many(t0 + np.arange(n) / fps) if local is None else local
+    if loc.shape[0] != n:
+        raise ValueError(f"local has {loc.shape[0]} frames, [t0, t1] at {fps} fps has {n}")
     joints = skeleton_joints()
     written = []
     for fi, (fig, out) in enumerate(zip(FIGURES, bvh_paths(path), strict=True)):

@@ -221,3 +221,64 @@ class Timeline:
             del self._items[:keep_from]
             del self._starts[:keep_from]
         return keep_from
+
+
+def clip_times(inst: Instance, t: np.ndarray) -> np.ndarray:
+    """:meth:`Instance.clip_time` over an array of session times."""
+    c = inst.clip
+    span = inst.impact - inst.start
+    if span <= 1e-9:
+        pre = np.full(t.shape, c.impact_s)
+    else:
+        pre = np.maximum(0.0, (t - inst.start) / span) * c.impact_s
+    post = np.minimum(c.impact_s + (t - inst.impact) * inst.rate, c.duration_s)
+    return np.where(t < inst.impact, pre, post)
+
+
+def weights(inst: Instance, t: np.ndarray) -> np.ndarray:
+    """:meth:`Instance.weight` over an array of session times."""
+    if inst.ramp_end is not None:
+        r0 = inst.start if inst.ramp_start is None else inst.ramp_start
+        span = inst.ramp_end - r0
+        w = np.ones(t.shape) if span <= 1e-9 else np.minimum((t - r0) / span, 1.0)
+        return np.where(t < r0, 0.0, w)
+    if inst.fade_in > 0:
+        return np.clip((t - inst.start) / inst.fade_in, 0.0, 1.0)
+    return np.ones(t.shape)
+
+
+def sample_frames_many(frames: np.ndarray, fps: float, times: np.ndarray) -> np.ndarray:
+    """:func:`virja.motion.clip.sample_frames` of all joints over an array of clip times:
+    (m, k, 4) from ``frames`` (n, k, 4)."""
+    n = frames.shape[0]
+    f = np.clip(times * fps, 0.0, n - 1.0)
+    i0 = f.astype(np.int64)
+    frac = f - i0
+    exact = (frac < 1e-9) | (i0 >= n - 1)
+    i1 = np.minimum(i0 + 1, n - 1)
+    q = (1.0 - frac)[:, None, None] * frames[i0] + frac[:, None, None] * frames[i1]
+    q = q / np.sqrt(np.einsum("mij,mij->mi", q, q))[..., None]
+    return np.where(exact[:, None, None], frames[i0], q)
+
+
+def blend_many(tl: Timeline, times: np.ndarray, below: np.ndarray) -> np.ndarray:
+    """:meth:`Timeline.blend` at many times at once: (m, k, 4) from ``below`` (m, k, 4).
+
+    ``times`` must be sorted ascending.  Each instance is applied, in start
+    order, to the times it covers (start <= t < end); as ends never decrease
+    along a timeline this is the set :meth:`Timeline.active` returns, and an
+    instance at full weight replaces what lies below, as in :meth:`Timeline.blend`.
+    """
+    acc = below.copy()
+    for inst in tl._items:
+        lo = int(np.searchsorted(times, inst.start, side="left"))
+        hi = int(np.searchsorted(times, inst.end, side="left"))
+        if hi <= lo:
+            continue
+        t = times[lo:hi]
+        w = weights(inst, t)
+        q = sample_frames_many(inst._frames(tl.joint_index), inst.clip.fps, clip_times(inst, t))
+        full = (w >= 1.0)[:, None, None]
+        mixed = quat.slerp(acc[lo:hi], q, w[:, None])
+        acc[lo:hi] = np.where(full, q, mixed)
+    return acc

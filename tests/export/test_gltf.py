@@ -1,0 +1,167 @@
+"""glTF export: the Khronos validator finds no errors; the node hierarchy reproduces the poses."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pygltflib
+import pytest
+
+from tests.export.conftest import GMD_TAKES, VALIDATOR, gmd_take
+from virja.export import Export, export_performance
+from virja.motion import quat
+from virja.motion.band import BandAnimator
+from virja.motion.skeleton import SKELETON
+
+
+def validate(path: Path) -> dict[str, Any]:
+    """The Khronos glTF Validator's report (npm gltf-validator, installed by tools/setup.sh)."""
+    node = shutil.which("node")
+    assert node, "node is needed for the glTF validator (tools/setup.sh)"
+    assert (VALIDATOR.parent / "node_modules" / "gltf-validator").is_dir(), (
+        "run tools/setup.sh: it installs gltf-validator into tools/node/node_modules"
+    )
+    out = subprocess.run(
+        [node, str(VALIDATOR), str(path)], capture_output=True, text=True, timeout=120, check=True
+    )
+    report: dict[str, Any] = json.loads(out.stdout)
+    return report
+
+
+def _errors(report: dict[str, Any]) -> list[Any]:
+    return [m for m in report["issues"]["messages"] if m["severity"] == 0]
+
+
+def test_demo_glb_passes_the_khronos_validator(demo_export: Export) -> None:
+    glb = next(p for p in demo_export.outputs if p.suffix == ".glb")
+    report = validate(glb)
+    assert report["issues"]["numErrors"] == 0, _errors(report)
+    assert report["issues"]["numWarnings"] == 0, report["issues"]["messages"]
+    assert report["info"]["animationCount"] == 1
+    assert report["info"]["hasMorphTargets"]  # the strings
+
+
+def _world(doc: pygltflib.GLTF2, node_i: int, parents: dict[int, int], rot: dict[int, Any]) -> Any:
+    """World matrix of a node with some rotations replaced (an independent TRS composition)."""
+    m = np.eye(4)
+    chain = [node_i]
+    while chain[-1] in parents:
+        chain.append(parents[chain[-1]])
+    for i in reversed(chain):
+        n = doc.nodes[i]
+        r = rot.get(i, n.rotation or [0, 0, 0, 1])
+        t = np.eye(4)
+        t[:3, 3] = n.translation or [0, 0, 0]
+        rm = np.eye(4)
+        rm[:3, :3] = quat.to_matrix(np.array([r[3], r[0], r[1], r[2]]))
+        s = np.diag([*(n.scale or [1, 1, 1]), 1.0])
+        m = m @ t @ rm @ s
+    return m
+
+
+def _frames(doc: pygltflib.GLTF2, acc_i: int) -> Any:
+    acc = doc.accessors[acc_i]
+    view = doc.bufferViews[acc.bufferView]
+    data = doc.binary_blob()[view.byteOffset : view.byteOffset + view.byteLength]
+    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[acc.type]
+    return np.frombuffer(data, dtype="<f4").reshape(acc.count, width)
+
+
+def test_glb_node_hierarchy_reproduces_the_band_pose(demo_export: Export, tmp_path: Path) -> None:
+    """pygltflib reads the file; composing its nodes' TRS with the animation's keyframe k
+    puts every joint where BandAnimator.pose puts it at that time (float32 precision)."""
+    glb = next(p for p in demo_export.outputs if p.suffix == ".glb")
+    doc = pygltflib.GLTF2().load(str(glb))
+    names = {n.name: i for i, n in enumerate(doc.nodes)}
+    for fig in ("drums", "bass"):
+        for joint in SKELETON.names:
+            assert f"{fig}_{joint}" in names
+    for piece in ("kit_ride", "kit_crash", "kit_hihat", "kit_pedal_kick", "kit_pedal_hihat"):
+        assert piece in names
+    assert "drums_stick_left" in names and "bass_string_G" in names
+    parents = {c: i for i, n in enumerate(doc.nodes) for c in (n.children or [])}
+    anims = {a.name: a for a in doc.animations}
+    assert set(anims) == {"band"}
+    times = _frames(doc, anims["band"].samplers[0].input)[:, 0]
+    assert len(times) == demo_export.frames
+    k = 200  # a frame in the second bar, both players busy
+    t0 = doc.scenes[0].extras["virja"]["t0_s"]
+    t = t0 + k / 30
+    rot: dict[int, Any] = {}
+    for a in anims.values():
+        for ch in a.channels:
+            if ch.target.path == "rotation":
+                rot[ch.target.node] = _frames(doc, a.samplers[ch.sampler].output)[k]
+    animator = _replan()
+    pose = animator.pose(t)
+    for fig, fp in (("drums", pose.drums), ("bass", pose.bass)):
+        for j, joint in enumerate(SKELETON.names):
+            world = _world(doc, names[f"{fig}_{joint}"], parents, rot)[:3, 3]
+            assert np.allclose(world, fp.positions[j], atol=1e-4), (fig, joint)
+    tip = _world(doc, names["drums_stick_right_tip"], parents, rot)[:3, 3]
+    assert np.allclose(tip, pose.sticks[1, 1], atol=1e-4)
+
+
+def _replan() -> BandAnimator:
+    from tests.conftest import DEMO_MID
+    from virja.input import load_performance_input
+    from virja.plan.planner import OnlinePlanner
+    from virja.routing import Router, RoutingConfig
+    from virja.session import Performance, run_schedule
+
+    src = load_performance_input(DEMO_MID, RoutingConfig())
+    animator = BandAnimator()
+    perf = Performance(
+        router=Router.for_session(src.midi, RoutingConfig()),
+        planner=OnlinePlanner(tempo=src.tempo),
+        animator=animator,
+    )
+    run_schedule(perf, src.schedule)
+    return animator
+
+
+@pytest.mark.parametrize("take", GMD_TAKES)
+def test_gmd_takes_export_valid_gltf_with_separate_buffer(take: str, tmp_path: Path) -> None:
+    out = tmp_path / "take.gltf"
+    written = export_performance(gmd_take(take), gltf=out, fps=24, end_s=8.0).outputs
+    assert written == [out, tmp_path / "take.bin"]
+    report = validate(out)
+    assert report["issues"]["numErrors"] == 0, _errors(report)
+    doc = json.loads(out.read_text())
+    assert doc["buffers"][0]["uri"] == "take.bin"
+    hihat = next(i for i, n in enumerate(doc["nodes"]) if n["name"] == "kit_hihat")
+    paths = {
+        c["target"]["path"]
+        for a in doc["animations"]
+        for c in a["channels"]
+        if c["target"]["node"] == hihat
+    }
+    assert paths == {"rotation", "translation"}  # swings and rises with the pedal
+
+
+def test_instrument_parts_move(demo_export: Export) -> None:
+    """Pedals, cymbals, the hi-hat and the strings have channels whose values change."""
+    glb = next(p for p in demo_export.outputs if p.suffix == ".glb")
+    doc = pygltflib.GLTF2().load(str(glb))
+    names = {i: n.name for i, n in enumerate(doc.nodes)}
+    moving: dict[str, float] = {}
+    for a in doc.animations:
+        for ch in a.channels:
+            values = _frames(doc, a.samplers[ch.sampler].output)
+            spread = float(np.max(values.max(axis=0) - values.min(axis=0)))
+            moving[f"{names[ch.target.node]}.{ch.target.path}"] = spread
+    for key in (
+        "kit_pedal_kick.rotation",
+        "kit_pedal_hihat.rotation",
+        "kit_crash.rotation",
+        "kit_ride.rotation",
+        "kit_hihat.translation",
+        "bass_string_E.weights",
+        "bass_string_G.weights",
+    ):
+        assert moving[key] > 1e-3, key

@@ -1,0 +1,95 @@
+"""Batched sampling (BandAnimator.local_rotations_many / poses) equals pose(t) frame by frame."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.conftest import DEMO_MID
+from virja.input import load_performance_input
+from virja.motion.band import BandAnimator
+from virja.plan.planner import OnlinePlanner
+from virja.routing import Router, RoutingConfig
+from virja.session import Performance, run_schedule
+
+GMD_TAKE = Path("/work/shared/data/gmd/drummer1/eval_session/1_funk-groove1_138_beat_4-4.mid")
+
+
+def _animate(path: Path) -> tuple[BandAnimator, tuple[float, float]]:
+    src = load_performance_input(path, RoutingConfig())
+    animator = BandAnimator()
+    perf = Performance(
+        router=Router.for_session(src.midi, RoutingConfig()),
+        planner=OnlinePlanner(tempo=src.tempo),
+        animator=animator,
+    )
+    run_schedule(perf, src.schedule)
+    return animator, src.default_span()
+
+
+@pytest.mark.parametrize("path", [DEMO_MID, GMD_TAKE], ids=["demo", "gmd"])
+def test_batched_local_rotations_equal_single_time_ones(path: Path) -> None:
+    if not path.is_file():
+        pytest.skip(f"{path} not here")
+    animator, (t0, t1) = _animate(path)
+    times = t0 + np.arange(int((min(t1, t0 + 12) - t0) * 30)) / 30
+    single = np.stack([animator.local_rotations(t) for t in times])
+    batch = animator.local_rotations_many(times)
+    assert batch.shape == single.shape
+    assert np.max(np.abs(batch - single)) < 1e-12
+
+
+def test_batched_poses_equal_pose() -> None:
+    animator, (t0, _) = _animate(DEMO_MID)
+    times = t0 + np.arange(0, 300, 7) / 30
+    for got, t in zip(animator.poses(times), times, strict=True):
+        want = animator.pose(float(t))
+        assert got.time_s == want.time_s
+        for a, b in ((got.drums, want.drums), (got.bass, want.bass)):
+            assert np.allclose(a.positions, b.positions, rtol=0, atol=1e-12)
+            assert np.allclose(a.rotations, b.rotations, rtol=0, atol=1e-12)
+        assert np.allclose(got.sticks, want.sticks, rtol=0, atol=1e-12)
+        assert got.hihat_open == pytest.approx(want.hihat_open, abs=1e-12)
+        assert got.cymbal_swing == want.cymbal_swing
+        assert got.string_vibration == want.string_vibration
+        assert got.string_stops == want.string_stops
+        assert got.head_hits == want.head_hits
+
+
+def test_batched_sampling_wants_sorted_times() -> None:
+    with pytest.raises(ValueError, match="sorted"):
+        BandAnimator().local_rotations_many(np.array([1.0, 0.5]))
+
+
+def _align_signs_loop(frames: np.ndarray) -> np.ndarray:
+    out = frames.copy()
+    for k in range(1, out.shape[0]):
+        flip = np.sum(out[k] * out[k - 1], axis=-1) < 0
+        out[k, flip] *= -1.0
+    return out
+
+
+def test_vectorised_align_signs_equals_the_frame_loop() -> None:
+    from virja.motion.clip import align_signs
+
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=(60, 9, 4))
+    assert np.array_equal(align_signs(q), _align_signs_loop(q))
+    q[10, 3] = 0.0  # a zero dot product: the sign restarts, as in the loop
+    assert np.array_equal(align_signs(q), _align_signs_loop(q))
+
+
+def test_sticks_of_many_frames_equal_one_at_a_time() -> None:
+    from virja.motion.band import sticks
+
+    animator, (t0, _) = _animate(DEMO_MID)
+    times = t0 + np.arange(0, 200, 13) / 30
+    loc = animator.local_rotations_many(times)
+    from virja.motion.skeleton import SKELETON
+
+    wpos, wrot = SKELETON.fk(loc[:, 0], animator.idle["drums"].root_positions[0])
+    many = sticks(wpos, wrot)
+    for k in range(len(times)):
+        assert np.array_equal(many[k], sticks(wpos[k], wrot[k]))

@@ -159,6 +159,29 @@ def test_batch_on_the_process_pool_writes_outputs_and_a_manifest(
     assert not (out / ".virja-partial").exists()
 
 
+def test_gltf_and_musicxml_come_from_one_export_pass(
+    corpus: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import xml.etree.ElementTree as ET
+
+    shutil.rmtree(corpus / "drummer1")
+    shutil.rmtree(corpus / "broken")
+    out = tmp_path / "out"
+    code = main(["batch", str(corpus), "--out", str(out), "--export", "gltf,musicxml,bvh"])
+    assert code == 0, capsys.readouterr()
+    (row,) = read_manifest(out / "manifest.jsonl")
+    stem = out / TAKES[2].removesuffix(".mid")
+    assert row["outputs"] == [
+        f"{stem}.glb",
+        f"{stem}.musicxml",
+        f"{stem}_drums.bvh",
+        f"{stem}_bass.bvh",
+    ]
+    assert Path(f"{stem}.glb").read_bytes()[:4] == b"glTF"
+    root = ET.parse(f"{stem}.musicxml").getroot()
+    assert root.tag == "score-partwise" and root.find("part") is not None
+
+
 def test_skip_existing_skips_done_inputs_and_retries_failed_ones(
     corpus: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

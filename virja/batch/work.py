@@ -10,7 +10,6 @@ status ``error`` and a one-line message naming the input.
 from __future__ import annotations
 
 import json
-import math
 import tempfile
 import time
 from collections.abc import Callable
@@ -23,7 +22,7 @@ from virja.errors import VirjaError
 from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
 from virja.plan.config import PlanConfig
 from virja.routing import Router, RoutingConfig
-from virja.session import Performance, RevealFeeder, frame_times, run_schedule
+from virja.session import Performance, RevealFeeder, run_schedule
 
 
 @dataclass(frozen=True)
@@ -65,21 +64,6 @@ def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> lis
     return [path]
 
 
-def _make_bvh(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
-    from virja.motion.export import performance_to_bvh
-
-    perf = _performance(src, settings, animate=True)
-    assert perf.animator is not None
-    t0, t1 = src.default_span()
-    feeder = RevealFeeder(src.schedule)
-    for t in frame_times(t0, t1, settings.fps):
-        feeder.until(perf, t)
-        perf.advance(t)
-    feeder.until(perf, math.inf)
-    perf.finish()
-    return performance_to_bvh(perf.animator, t0, t1, settings.fps, out / "take.bvh")
-
-
 def _make_mp4(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
     from virja.render.camera import PRESETS
     from virja.render.offline import OutputSpec, render_offline
@@ -111,9 +95,43 @@ Producer = Callable[[PerformanceInput, Path, BatchSettings], list[Path]]
 # each producer returns its files in the order of jobs.OUTPUT_NAMES[kind]
 PRODUCERS: dict[OutputKind, Producer] = {
     OutputKind.PLAN: _make_plan,
-    OutputKind.BVH: _make_bvh,
     OutputKind.MP4: _make_mp4,
 }
+EXPORTED = (OutputKind.BVH, OutputKind.GLTF, OutputKind.MUSICXML)  # one `virja export` pass
+
+
+def _export(
+    src_path: Path, kinds: list[OutputKind], out: Path, settings: BatchSettings
+) -> dict[OutputKind, list[Path]]:
+    """BVH, glTF and MusicXML in one pass of :func:`virja.export.export_performance`
+    (one plan and one sampling of the band for all three)."""
+    from virja.export.driver import export_performance
+
+    paths = {
+        OutputKind.BVH: out / "take.bvh",
+        OutputKind.GLTF: out / "take.glb",
+        OutputKind.MUSICXML: out / "take.musicxml",
+    }
+    done = export_performance(
+        src_path,
+        bvh=paths[OutputKind.BVH] if OutputKind.BVH in kinds else None,
+        gltf=paths[OutputKind.GLTF] if OutputKind.GLTF in kinds else None,
+        musicxml=paths[OutputKind.MUSICXML] if OutputKind.MUSICXML in kinds else None,
+        fps=settings.fps,
+        routing=settings.routing,
+        plan_config=settings.plan,
+        lookahead_beats=settings.lookahead_beats,
+    )
+    written = set(done.outputs)
+    made: dict[OutputKind, list[Path]] = {}
+    for kind in kinds:
+        if kind is OutputKind.BVH:
+            made[kind] = [
+                p for p in (out / "take_drums.bvh", out / "take_bass.bvh") if p in written
+            ]
+        else:
+            made[kind] = [paths[kind]]
+    return made
 
 
 def _message(exc: BaseException, tmp_input: Path, rel: str) -> str:
@@ -133,12 +151,20 @@ def run_job(job: Job, data: bytes, settings: BatchSettings) -> JobResult:
             )
             if src.note_count == 0:
                 raise nothing_for_the_band(src_path, src.report)
+            made: dict[OutputKind, list[Path]] = {}
+            exported = [k for k in job.kinds if k in EXPORTED]
+            if exported:
+                out = Path(tmp) / "export"
+                out.mkdir()
+                made.update(_export(src_path, exported, out, settings))
+            for kind in job.kinds:
+                if kind not in EXPORTED:
+                    out = Path(tmp) / kind.value
+                    out.mkdir()
+                    made[kind] = PRODUCERS[kind](src, out, settings)
             files: dict[str, bytes] = {}
             for kind in job.kinds:
-                out = Path(tmp) / kind.value
-                out.mkdir()
-                made = PRODUCERS[kind](src, out, settings)
-                for name, path in zip(job.output_names(kind), made, strict=True):
+                for name, path in zip(job.output_names(kind), made[kind], strict=True):
                     files[name] = path.read_bytes()
         except Exception as exc:  # one bad file never stops the batch
             return JobResult(

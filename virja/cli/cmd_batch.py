@@ -3,9 +3,11 @@
 Walks INPUT_DIR for MIDI files and pcaps, and for each writes the outputs named
 by --export under OUT_DIR, mirroring the input's path below INPUT_DIR:
 
-  plan      NAME.plan.jsonl              the plan, as `virja plan --json` prints it
+  plan      NAME.plan.jsonl                the plan, as `virja plan --json` prints it
   bvh       NAME_drums.bvh, NAME_bass.bvh  each figure's motion (as `virja export --bvh`)
-  mp4       NAME.mp4                     video with sound (as `virja render`)
+  gltf      NAME.glb                       the band animated (as `virja export --gltf`)
+  musicxml  NAME.musicxml                  notation, string/fret and sticking (`virja export`)
+  mp4       NAME.mp4                       video with sound (as `virja render`)
 
 OUT_DIR/manifest.jsonl gets one JSON object per input: input, status (ok, error
 or skipped), outputs, seconds, and error (the message) when it failed.  A bad
@@ -19,7 +21,7 @@ cores); with --ray on a Ray cluster: a local one, or the one at ADDRESS
 examples:
   virja batch ../shared/data/gmd --out out/gmd --export plan,bvh
   virja batch corpus/ --out out/corpus --export plan --skip-existing --workers 2
-  virja batch corpus/ --out out/corpus --export plan,bvh --ray            # local Ray
+  virja batch corpus/ --out out/corpus --export gltf,musicxml --ray       # local Ray
   virja batch corpus/ --out /shared/out --export plan --ray ray://head:10001
 """
 

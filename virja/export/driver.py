@@ -22,7 +22,7 @@ from virja.events import Beat
 from virja.export.gltf import Sampled, write_gltf
 from virja.export.musicxml import Score, write_musicxml
 from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, GEOMETRY
-from virja.input import PerformanceInput, load_performance_input
+from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
 from virja.motion.band import BandAnimator
 from virja.motion.export import performance_to_bvh
 from virja.plan.config import PlanConfig, load_plan_config
@@ -159,6 +159,7 @@ def export_performance(
     config: str | Path | None = None,
     routing: RoutingConfig | None = None,
     lookahead_beats: float = 1.0,
+    plan_config: PlanConfig | None = None,
 ) -> Export:
     """Plan and animate a MIDI file or pcap recording and write the requested formats.
 
@@ -167,7 +168,8 @@ def export_performance(
     - ``musicxml``: ``.musicxml`` (MusicXML 4.0, uncompressed);
     - ``fps``: motion sampling rate; ``start_s``/``end_s``: the span in session
       seconds (default: from the first motion to the last note plus 1.5 s);
-    - ``config``: a virja TOML file ([routing], [plan]); ``routing`` overrides its [routing].
+    - ``config``: a virja TOML file ([routing], [plan]); ``routing`` overrides its [routing]
+      and ``plan_config`` (already parsed, as `virja batch` hands it to its workers) its [plan].
 
     Raises :class:`~virja.errors.ConfigError` / :class:`~virja.errors.InputFileError`
     (one-line messages) for a bad request before any work is done.
@@ -180,10 +182,11 @@ def export_performance(
     doc = load_config(str(config)) if config is not None else {}
     if routing is None:
         routing = RoutingConfig.from_dict(section(doc, "routing"), f"{config} [routing]")
-    plan_config: PlanConfig = load_plan_config(config)
+    if plan_config is None:
+        plan_config = load_plan_config(config)
     src = load_performance_input(src_path, routing, lookahead_beats=lookahead_beats)
     if src.note_count == 0:
-        raise InputFileError(src_path, "no notes for the band (bass or drums) in this input")
+        raise nothing_for_the_band(src_path, src.report)
     # notation needs only the plan: MusicXML alone skips the animator (so a tuning the
     # bassist's clips do not cover yet still gets its tablature)
     animator = BandAnimator() if (g or b) else None

@@ -280,7 +280,8 @@ def test_batch_on_a_local_ray_cluster_gives_the_same_outputs(
     ("extra", "message"),
     [
         (["--export", "pdf"], "unknown output 'pdf'"),
-        (["--workers", "0"], "--workers must be at least 1"),
+        (["--workers", "0"], "--workers must be 1-1024"),
+        (["--workers", "99999999999999999999"], "--workers must be 1-1024"),
         (["--fps", "0"], "--fps must be in"),
         (["--size", "big"], "size must look like"),
         (["--config", "/nonexistent.toml"], "nonexistent.toml"),

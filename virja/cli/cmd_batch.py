@@ -38,6 +38,8 @@ from virja.batch.manifest import MANIFEST_NAME, Status
 from virja.cli.common import add_routing_arguments, finite_float, routing_config
 from virja.errors import ConfigError
 
+MAX_WORKERS = 1024  # processes (or Ray tasks in flight) at once; more is a typo
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("input_dir", metavar="INPUT_DIR", help="folder walked for .mid/.midi/.pcap")
@@ -122,8 +124,8 @@ def run(args: argparse.Namespace) -> int:
     from virja.render.offline import parse_size
 
     kinds = parse_kinds(args.export)
-    if args.workers is not None and args.workers < 1:
-        raise ConfigError(f"--workers must be at least 1, got {args.workers}")
+    if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
+        raise ConfigError(f"--workers must be 1-{MAX_WORKERS}, got {args.workers}")
     if not 0 < args.fps <= 240:
         raise ConfigError(f"--fps must be in (0, 240], got {args.fps}")
     if args.lookahead_beats < 0:

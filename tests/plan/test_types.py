@@ -36,6 +36,11 @@ def test_json_round_trip() -> None:
     assert PlannedNote.from_json(P.to_json()) == P
 
 
+def test_json_channel_counts_as_musicians_do() -> None:
+    """The drums are channel 10 in the plan log, as in every message and option."""
+    assert P.to_json()["channel"] == 10
+
+
 def test_from_json_rejects_missing_keys() -> None:
     data = P.to_json()
     del data["cost"]

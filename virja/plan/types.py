@@ -63,10 +63,12 @@ class PlannedNote:
 
     def to_json(self) -> dict[str, Any]:
         """A dict with exactly :data:`JSON_KEYS`, in that order; times rounded to the
-        microsecond (the wire's resolution), so logs carry no float noise."""
+        microsecond (the wire's resolution), so logs carry no float noise; the channel
+        1-16 (10 for drums) as every message and option names it (it is 0-15 inside)."""
         out = {key: getattr(self, key) for key in JSON_KEYS}
         for key in ("time", "start", "impact"):
             out[key] = round(out[key], 6)
+        out["channel"] = self.channel + 1  # 1-16, as musicians and every message count
         return out
 
     @classmethod
@@ -80,7 +82,7 @@ class PlannedNote:
         return cls(
             time=float(data["time"]),
             performer=data["performer"],
-            channel=int(data["channel"]),
+            channel=int(data["channel"]) - 1,
             note=int(data["note"]),
             velocity=int(data["velocity"]),
             limb=data["limb"],

@@ -9,6 +9,7 @@ APT_PACKAGES=(
   xvfb xauth                                   # a real window in tests and on servers
   fluidsynth fluid-soundfont-gm                # MIDI -> audio for videos with sound
   jackd2                                       # live MIDI ports (jam) through JACK
+  chromium                                     # the browser viewer's tests (Playwright drives it)
 )
 
 missing=()

@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 import logging
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import IO, TYPE_CHECKING
 
@@ -54,9 +54,12 @@ class Performance:
         self.planned: list[PlannedNote] = []
         self.keep_planned = True
         self.hud = HudTimeline()  # tempo, bar.beat and chord for the heads-up display
+        self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""
+        for tap in self.taps:
+            tap(event)
         if isinstance(event, Beat):
             self._beat(event)
             return None

@@ -10,6 +10,7 @@ reason, late notes, the clock offset.
 examples:
   virja serve --headless --plan-log plan.jsonl --record session.pcap
   virja serve --listen [::]:50500 --group 239.255.50.50
+  virja serve --headless --web 127.0.0.1:8080   # watch at http://127.0.0.1:8080/
   virja send virja/demo/blues.mid --to 127.0.0.1:50500   # in another shell
 """
 
@@ -25,6 +26,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
+from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import load_config
 from virja.errors import ConfigError
 
@@ -88,6 +90,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--size", default="1280x720", metavar="WxH", help="window size (default 1280x720)"
     )
     p.add_argument("--quiet", action="store_true", help="no status line")
+    add_web_arguments(p)
     add_routing_arguments(p)
 
 
@@ -223,8 +226,9 @@ async def serve(args: argparse.Namespace) -> int:
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_listener(host, port, protocol, group=args.group)
     bound = transport.get_extra_info("sockname")
-    view = None
+    view = web = None
     try:
+        web = open_web(args, perf, lambda: clock.now_us() / 1e6)
         if not args.headless:
             from virja.render.live import LiveView
 
@@ -240,6 +244,8 @@ async def serve(args: argparse.Namespace) -> int:
         transport.close()
         if view is not None:
             view.close()
+        if web is not None:
+            web.close()
         if perf.plan_log is not None:
             perf.plan_log.close()
         raise
@@ -249,6 +255,8 @@ async def serve(args: argparse.Namespace) -> int:
         + (f", group {args.group}" if args.group else ""),
         flush=True,
     )
+    if web is not None:
+        print(f"virja serve: web viewer at {web.url}", flush=True)
 
     stop = asyncio.Event()
     loop = asyncio.get_running_loop()
@@ -268,6 +276,8 @@ async def serve(args: argparse.Namespace) -> int:
         last_status = time.monotonic()
         while not stop.is_set():
             daemon.tick()
+            if web is not None:
+                web.publish(perf, clock.now_us() / 1e6)
             if view is not None:
                 now_s = clock.now_us() / 1e6
                 view.frame(perf, now_s)
@@ -298,7 +308,9 @@ async def serve(args: argparse.Namespace) -> int:
             plan_log.close()
         if view is not None:
             view.close()
+        if web is not None:
+            web.close()
     print("virja serve: stopped")
-    for line in daemon.summary():
+    for line in daemon.summary() + ([web.summary()] if web is not None else []):
         print(f"  {line}")
     return 0

@@ -23,6 +23,13 @@ from virja.render.shaders import load_program
 F64 = NDArray[np.float64]
 
 BACKGROUND = (0.055, 0.06, 0.085)
+# the shader's lights (also sent to the browser viewer, virja.web): directions towards
+# the key and fill lights, the stage spot's position
+LIGHTS: dict[str, tuple[float, float, float]] = {
+    "u_key_dir": (0.35, 0.85, 0.55),
+    "u_fill_dir": (-0.6, 0.3, 0.4),
+    "u_spot_pos": (0.0, 3.2, 1.6),
+}
 _EMPTY = np.zeros((0, 20), dtype=np.float32)
 
 
@@ -132,9 +139,9 @@ class Renderer:
         vp = camera.view_proj(w / max(h, 1))
         self._uniform("u_view_proj").write(vp.T.astype("f4").tobytes())
         self._set("u_eye", tuple(float(x) for x in camera.eye))
-        self._set("u_key_dir", _unit((0.35, 0.85, 0.55)))
-        self._set("u_fill_dir", _unit((-0.6, 0.3, 0.4)))
-        self._set("u_spot_pos", (0.0, 3.2, 1.6))
+        self._set("u_key_dir", _unit(LIGHTS["u_key_dir"]))
+        self._set("u_fill_dir", _unit(LIGHTS["u_fill_dir"]))
+        self._set("u_spot_pos", LIGHTS["u_spot_pos"])
         self._set("u_fog_color", BACKGROUND)
 
     def _static_layer(

@@ -1,0 +1,54 @@
+"""``--web [HOST:PORT]`` for serve, replay and jam: the browser viewer (docs/web.md)."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from virja.errors import ConfigError
+
+if TYPE_CHECKING:
+    from virja.session import Performance
+    from virja.web.feed import WebFeed
+
+DEFAULT_WEB = "127.0.0.1:8080"
+
+
+def add_web_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--web",
+        nargs="?",
+        const=DEFAULT_WEB,
+        metavar="HOST:PORT",
+        help=f"serve a browser viewer at http://HOST:PORT/ (default {DEFAULT_WEB}; "
+        "0.0.0.0:8080 lets other machines watch)",
+    )
+    p.add_argument(
+        "--web-fps",
+        type=float,
+        default=30.0,
+        metavar="FPS",
+        help="frames per second sent to each browser (default 30; the page interpolates)",
+    )
+
+
+def open_web(
+    args: argparse.Namespace, perf: Performance, now_s: Callable[[], float]
+) -> WebFeed | None:
+    """Start the viewer's server when --web is given (its address in ``feed.url``)."""
+    if not getattr(args, "web", None):
+        return None
+    from virja.rmcp.transport import parse_hostport
+    from virja.web.feed import WebFeed
+
+    host, port = parse_hostport(args.web, default_port=8080)
+    try:
+        feed = WebFeed(host, port, now_s, fps=args.web_fps)
+    except ValueError as exc:
+        raise ConfigError(f"--web-fps: {exc}") from None
+    bound = feed.start()
+    feed.attach(perf)
+    shown = f"[{bound[0]}]" if ":" in bound[0] else bound[0]
+    feed.url = f"http://{shown}:{bound[1]}/"
+    return feed

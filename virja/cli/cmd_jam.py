@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 from virja.cli.common import finite_float
+from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import section
 from virja.errors import ConfigError, InputFileError
 
@@ -92,6 +93,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="stop after this long",
     )
     parser.add_argument("--config", default=None, metavar="FILE.toml", help="configuration file")
+    add_web_arguments(parser)
 
 
 def _options(args: argparse.Namespace, doc: dict[str, Any]) -> JamOptions:
@@ -211,7 +213,7 @@ def run(args: argparse.Namespace) -> int:
         perf = build_performance(
             doc,
             plan_log=log_fh,
-            animate=not args.headless,
+            animate=not args.headless or bool(args.web),
             delay_s=opts.delay_s,
             config_path=args.config,
         )
@@ -221,6 +223,9 @@ def run(args: argparse.Namespace) -> int:
 
             view = LiveView(title="virja jam")
             stack.callback(view.close)
+        web = open_web(args, perf, clock.now_s)
+        if web is not None:
+            stack.callback(web.close)
         thru = None
         if opts.thru is not None:
             thru = MidiOutput(api, opts.thru, clock.now_s)
@@ -240,13 +245,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"virja jam: {api} input {where} {midi_in.name}")
         if thru is not None:
             print(f"virja jam: thru -> {thru.name} (delay {opts.delay_ms:g} ms)")
+        if web is not None:
+            print(f"virja jam: web viewer at {web.url}")
         if send_to is not None:
             print(f"virja jam: streaming RMCP/1 to {send_to[0]}:{send_to[1]}")
         for keys, what in routing_table(opts.layout):
             print(f"  {keys}: {what}")
         sys.stdout.flush()
 
-        counts = _loop(perf, jam, midi_in, thru, clock.now_s, opts.fps, args.duration, view)
+        counts = _loop(perf, jam, midi_in, thru, clock.now_s, opts.fps, args.duration, view, web)
         perf.finish()
     print(
         f"virja jam: {midi_in.received} messages, {counts['bass']} bass and "
@@ -265,6 +272,7 @@ def _loop(
     fps: float,
     duration_s: float | None,
     view: Any = None,
+    web: Any = None,
 ) -> dict[str, int]:
     """The live timer: feed what arrived, commit motions, follow ports; until time or Ctrl-C."""
     counts = {"bass": 0, "drums": 0}
@@ -281,6 +289,10 @@ def _loop(
                 counts[performer] += 1
                 perf.feed_routed(performer, arrival.routed.event, now_s=arrival.arrival_s)
             perf.advance(now)
+            if web is not None:
+                web.publish(perf, now)
+                if view is None and perf.animator is not None:
+                    perf.animator.forget_before(now - 20.0)
             if view is not None:
                 view.frame(perf, now)
                 if view.closed:

@@ -4,13 +4,15 @@ The recorded datagrams are fed at their recorded receive times (a virtual
 clock), so --plan-log gives the plan the live daemon made.  With --out the
 band is rendered headless to a video or PNG frames (as `virja render`); with
 --headless nothing is drawn (plan log and summary only, as fast as possible);
-otherwise it plays in a window in real time.  Reads pcaps written by
+otherwise it plays in a window in real time (and with --web to browsers,
+window or not).  Reads pcaps written by
 `virja serve --record`, tcpdump or Wireshark (pcap and pcapng).
 
 examples:
   virja replay session.pcap --headless --plan-log replay.jsonl
   virja replay session.pcap --out session.mp4
   virja replay capture.pcapng --port 50600
+  virja replay session.pcap --headless --web      # watch at http://127.0.0.1:8080/
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from virja.cli.common import (
     make_router,
     open_plan_log,
 )
+from virja.cli.web_option import add_web_arguments, open_web
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
 
@@ -59,6 +62,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     from virja.cli.cmd_render import add_dancer_argument
 
     add_dancer_argument(p)
+    add_web_arguments(p)
     add_routing_arguments(p)
 
 
@@ -102,30 +106,45 @@ def play(src: object, args: argparse.Namespace) -> int:
     perf = Performance(
         router=make_router(args),
         planner=OnlinePlanner(load_plan_config(args.config)),
-        animator=None if args.headless else BandAnimator(),
+        animator=None if args.headless and not args.web else BandAnimator(),
         plan_log=plan_log,
     )
     feeder = RevealFeeder(src.schedule)
     t0, t1 = src.default_span()
     try:
-        if args.headless:
+        if args.headless and not args.web:
             run_schedule(perf, src.schedule)
         else:
             from virja.render.live import LiveView
             from virja.render.offline import parse_size
 
-            view = LiveView(parse_size(args.size), title=f"virja replay {Path(args.input).name}")
+            view = None
+            if not args.headless:
+                view = LiveView(
+                    parse_size(args.size), title=f"virja replay {Path(args.input).name}"
+                )
             wall0 = time.perf_counter()
+            web = open_web(args, perf, lambda: t0 + (time.perf_counter() - wall0))
+            if web is not None:
+                print(f"virja replay: web viewer at {web.url}", flush=True)
             try:
-                while not view.closed:
+                while view is None or not view.closed:
                     t = t0 + (time.perf_counter() - wall0)
                     if t > t1:
                         break
                     feeder.until(perf, t)
                     perf.advance(t)
-                    view.frame(perf, t)
+                    if web is not None:
+                        web.publish(perf, t)
+                    if view is not None:
+                        view.frame(perf, t)
+                    else:
+                        time.sleep(0.005)
             finally:
-                view.close()
+                if view is not None:
+                    view.close()
+                if web is not None:
+                    web.close()
             feeder.until(perf, math.inf)
             perf.finish()
     finally:

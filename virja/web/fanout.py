@@ -23,7 +23,9 @@ class ViewerQueue:
 
     def __init__(self, max_frames: int = MAX_FRAMES, max_messages: int = MAX_MESSAGES) -> None:
         if max_frames < 1 or max_messages < max_frames:
-            raise ValueError("a viewer queue holds at least one frame and max_messages >= max_frames")
+            raise ValueError(
+                "a viewer queue holds at least one frame and max_messages >= max_frames"
+            )
         self.max_frames = max_frames
         self.max_messages = max_messages
         self._items: deque[tuple[bool, Message]] = deque()

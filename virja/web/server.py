@@ -13,6 +13,7 @@ never blocks) and each viewer's writer drains its own bounded queue
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import gzip
 import json
 import logging
@@ -221,10 +222,8 @@ class WebServer:
             self.stats.dropped += q.dropped
             q.close()
             writer.cancel()
-            try:
+            with contextlib.suppress(asyncio.CancelledError, Exception):
                 await writer
-            except (asyncio.CancelledError, Exception):
-                pass
 
     async def _write(self, ws: Any, q: ViewerQueue) -> None:
         while True:

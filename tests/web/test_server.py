@@ -62,7 +62,12 @@ def test_the_page_and_everything_it_loads_come_from_virja(feed: WebFeed) -> None
 
 
 def test_only_the_routes_in_the_table_are_served(feed: WebFeed) -> None:
-    for path in ("/pyproject.toml", "/../pyproject.toml", "/three/../server.py", "/static/viewer.js"):
+    for path in (
+        "/pyproject.toml",
+        "/../pyproject.toml",
+        "/three/../server.py",
+        "/static/viewer.js",
+    ):
         assert get(base(feed) + path)[0] == 404, path
 
 

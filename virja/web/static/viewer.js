@@ -7,7 +7,8 @@
 // shows, interpolated between the two frames around it.  The shader is the native
 // renderer's own shaders/solid.glsl.
 //
-// URL parameters: camera=front|drums|bass|top, transparent=1, floor=0|1, status=0, ws=URL.
+// URL parameters: camera=front|drums|bass|top, transparent=1, floor=0|1, status=0, fps=N
+// (cap the drawing rate), ws=URL.
 // Keys: 1-4 cameras, arrows orbit, +/- zoom, H status line, F fullscreen.  Drag to orbit,
 // wheel to zoom.
 
@@ -23,6 +24,7 @@ const showFloor = flag('floor', !transparent);
 const statusEl = document.getElementById('status');
 if (!flag('status', true)) statusEl.classList.add('hidden');
 if (transparent) document.body.classList.add('transparent');
+const minFrameMs = params.has('fps') ? 1000 / Math.max(1, Number(params.get('fps')) || 60) : 0;
 const wsUrl = params.get('ws') || `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`;
 
 // float16 -> float32, once
@@ -47,6 +49,21 @@ const stats = {
   connected: false, hello: false, instances: 0,
 };
 window.virjaStats = stats;
+// the picture as drawn, every step-th pixel, top row first, RGBA bytes in base64 (tests, tools)
+window.virjaPixels = (step = 2) => {
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+  const buf = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, buf);
+  let bin = '';
+  for (let y = h - 1; y >= 0; y -= step) {
+    for (let x = 0; x < w; x += step) {
+      const i = (y * w + x) * 4;
+      bin += String.fromCharCode(buf[i], buf[i + 1], buf[i + 2], buf[i + 3]);
+    }
+  }
+  return { w: Math.ceil(w / step), h: Math.ceil(h / step), rgba: btoa(bin) };
+};
 
 // --- the orbit camera, as virja/render/camera.py --------------------------------------
 let presets = {};
@@ -331,8 +348,11 @@ function connect() {
   };
 }
 
-function draw() {
+let lastDrawMs = -Infinity;
+function draw(nowMs) {
   requestAnimationFrame(draw);
+  if (nowMs - lastDrawMs < minFrameMs - 1) return;
+  lastDrawMs = nowMs;
   const T = sessionNow();
   statusEl.textContent = statusText(T);
   if (!material || !cam) return;
@@ -345,4 +365,4 @@ function draw() {
   stats.draws++;
 }
 
-loadShader().then(() => { connect(); draw(); }).catch((e) => { statusEl.textContent = `virja viewer: ${e.message}`; console.error(e); });
+loadShader().then(() => { connect(); requestAnimationFrame(draw); }).catch((e) => { statusEl.textContent = `virja viewer: ${e.message}`; console.error(e); });

@@ -31,6 +31,13 @@ def add_web_arguments(p: argparse.ArgumentParser) -> None:
         metavar="FPS",
         help="frames per second sent to each browser (default 30; the page interpolates)",
     )
+    p.add_argument(
+        "--web-lead-ms",
+        type=float,
+        default=100.0,
+        metavar="MS",
+        help="sample frames this far ahead of the clock, to arrive in time (default 100)",
+    )
 
 
 def open_web(
@@ -43,8 +50,10 @@ def open_web(
     from virja.web.feed import WebFeed
 
     host, port = parse_hostport(args.web, default_port=8080)
+    if not 0.0 <= args.web_lead_ms <= 2000.0:
+        raise ConfigError(f"--web-lead-ms must be 0-2000, got {args.web_lead_ms:g}")
     try:
-        feed = WebFeed(host, port, now_s, fps=args.web_fps)
+        feed = WebFeed(host, port, now_s, fps=args.web_fps, lead_s=args.web_lead_ms / 1000)
     except ValueError as exc:
         raise ConfigError(f"--web-fps: {exc}") from None
     bound = feed.start()

@@ -135,8 +135,9 @@ class WebFeed:
     def summary(self) -> str:
         st = self.server.stats
         return (
-            f"web: {st.viewers_total} viewers, {self.frames} frames, "
-            f"{st.bytes_queued / 1e6:.1f} MB queued, {self.dropped} frames dropped for slow viewers"
+            f"web: {st.viewers_total} viewers, {self.frames} frames "
+            f"({self.skipped} skipped while encoding), {st.bytes_queued / 1e6:.1f} MB queued, "
+            f"{self.dropped} frames dropped for slow viewers"
         )
 
     @property

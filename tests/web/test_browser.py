@@ -95,6 +95,12 @@ def test_three_browsers_watch_the_band_play_what_send_sends(tmp_path: Path) -> N
                         page.screenshot(path=str(tmp_path / f"{name}.png"))
             status = pages["front"].inner_text("#status")
             stats = {n: p.evaluate("() => window.virjaStats") for n, p in pages.items()}
+            # the page's session clock (serve without --clock-server: this machine's Unix time)
+            before = time.time()
+            page_now = pages["front"].evaluate(
+                "() => performance.now() / 1000 + window.virjaStats.offset"
+            )
+            after = time.time()
             overlay_hidden = pages["overlay"].evaluate(
                 "() => document.getElementById('status').classList.contains('hidden')"
             )
@@ -117,4 +123,5 @@ def test_three_browsers_watch_the_band_play_what_send_sends(tmp_path: Path) -> N
     alpha = shots["overlay"][-1][..., 3]
     assert (alpha == 0).mean() > 0.3 and (alpha == 255).mean() > 0.05
     assert overlay_hidden
+    assert before - 0.05 < page_now < after + 0.05, (before, page_now, after)
     assert re.search(r"♩ = \d+\s+bar \d+\.\d\s+\S+\s+connected", status), status

@@ -36,7 +36,7 @@ def test_a_recording_replays_to_a_browser_viewer(tmp_path: Path) -> None:
             m = re.search(r"web viewer at http://(127\.0\.0\.1:\d+)/", line)
             url = m and m.group(1)
         times = []
-        with connect(f"ws://{url}/ws") as ws:
+        with connect(f"ws://{url}/ws", max_queue=None) as ws:
             deadline = time.monotonic() + 10
             while len(times) < 20 and time.monotonic() < deadline:
                 msg = ws.recv(timeout=10)

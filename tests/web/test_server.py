@@ -81,7 +81,7 @@ def test_a_viewer_gets_hello_then_beats_chords_and_frames_and_its_clock_pings_an
     )
     feed.attach(perf)
     perf.feed(Beat(1.0, 2, 3, 4, 0, 500_000), now_s=0.5)  # told to viewers who come later
-    with connect(base(feed).replace("http", "ws") + "/ws") as ws:
+    with connect(base(feed).replace("http", "ws") + "/ws", max_queue=None) as ws:
         hello = json.loads(ws.recv(timeout=10))
         assert hello["type"] == "hello" and hello["fps"] == 60
         beat = json.loads(ws.recv(timeout=10))

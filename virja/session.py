@@ -55,6 +55,7 @@ class Performance:
         self.keep_planned = True
         self.hud = HudTimeline()  # tempo, bar.beat and chord for the heads-up display
         self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
+        self.planned_taps: list[Callable[[PlannedNote], None]] = []  # and every note committed
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""
@@ -106,6 +107,8 @@ class Performance:
 
     def _commit(self, notes: list[PlannedNote]) -> list[PlannedNote]:
         for p in notes:
+            for tap in self.planned_taps:
+                tap(p)
             if self.animator is not None:
                 self.animator.add_planned(p)
             if self.plan_log is not None:

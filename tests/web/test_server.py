@@ -134,3 +134,28 @@ def test_web_without_an_address_binds_loopback_port_8080() -> None:
     add_web_arguments(p)
     assert p.parse_args(["--web"]).web == "127.0.0.1:8080"
     assert p.parse_args([]).web is None
+
+
+def test_each_impact_gets_a_frame_at_its_own_instant(feed: WebFeed) -> None:
+    perf = Performance(
+        router=Router(RoutingConfig()),
+        planner=OnlinePlanner(load_plan_config(None)),
+        animator=BandAnimator(),
+    )
+    feed.attach(perf)
+    with connect(base(feed).replace("http", "ws") + "/ws", max_queue=None) as ws:
+        while feed.server.viewers == 0:
+            time.sleep(0.01)
+        perf.feed(NoteOn(1.3083, 9, 38, 100), now_s=1.0)
+        for k in range(31):
+            now = 1.0 + k / 60
+            perf.advance(now)
+            feed.publish(perf, now)
+            time.sleep(1 / 60)
+        times = []
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and not any(abs(t - 1.3083) < 1e-9 for t in times):
+            msg = ws.recv(timeout=10)
+            if isinstance(msg, bytes):
+                times.append(decode_frame(msg)[1])
+    assert any(abs(t - 1.3083) < 1e-9 for t in times), times

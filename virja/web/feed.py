@@ -16,6 +16,7 @@ status line shows the ones in force at the moment drawn.
 
 from __future__ import annotations
 
+import bisect
 import json
 import threading
 from collections import deque
@@ -30,11 +31,13 @@ from virja.web.server import WebServer
 
 if TYPE_CHECKING:
     from virja.motion.pose import BandPose
+    from virja.plan.types import PlannedNote
     from virja.session import Performance
 
 DEFAULT_FPS = 30.0
 DEFAULT_LEAD_S = 0.1  # frames are sampled this far ahead: delivery and one frame period
 KEEP_STATUS = 16  # recent beats and chords a new viewer is told
+IMPACT_GAP_S = 0.004  # an impact this close to a frame already sent gets no frame of its own
 
 NOTE_NAMES = ("C", "Db", "D", "Eb", "E", "F", "Gb", "G", "Ab", "A", "Bb", "B")
 
@@ -87,6 +90,8 @@ class WebFeed:
         self._lock = threading.Lock()
         self.server = WebServer(host, port, greeting=self._greeting, now_s=now_s)
         self._next_s = float("-inf")
+        self._impacts: list[float] = []  # impact times not yet sent as frames of their own
+        self._sent: list[float] = []  # recent frame times, ascending
         self._seq = 0
         self._encoding = False
         self.frames = 0
@@ -99,6 +104,13 @@ class WebFeed:
     def attach(self, perf: Performance) -> None:
         """Tap the performance's events, for the status line's beats and chords."""
         perf.taps.append(self.observe)
+        perf.planned_taps.append(self.planned)
+
+    def planned(self, note: PlannedNote) -> None:
+        """A committed motion: its impact instant gets a frame of its own, so the stick is
+        drawn on the head at the moment of the note, not between two grid frames."""
+        if self.server.viewers:
+            bisect.insort(self._impacts, note.impact)
 
     def observe(self, event: Event) -> None:
         msg = status_message(event)
@@ -109,17 +121,36 @@ class WebFeed:
         self.server.broadcast(msg, droppable=False)
 
     def publish(self, perf: Performance, now_s: float) -> None:
-        """Call often (every tick): sends a frame when one is due and someone watches."""
-        if now_s < self._next_s or self.server.viewers == 0:
+        """Call often (every tick): sends a frame when one is due and someone watches;
+        and one at each impact instant within the lead that is not yet past."""
+        if self.server.viewers == 0:
+            self._impacts.clear()
+            return
+        horizon = now_s + self.lead_s
+        while self._impacts and self._impacts[0] <= horizon and not self._encoding:
+            t = self._impacts.pop(0)
+            if t > now_s and not self._near_sent(t):
+                self._send(perf, t)
+        if now_s < self._next_s:
             return
         step = 1.0 / self.fps
         self._next_s = max(self._next_s + step, now_s - step)
         if self._encoding:  # the server thread is behind: skip rather than queue
             self.skipped += 1
             return
+        self._send(perf, horizon)
+
+    def _near_sent(self, t: float) -> bool:
+        i = bisect.bisect_left(self._sent, t)
+        near = [self._sent[j] for j in (i - 1, i) if 0 <= j < len(self._sent)]
+        return any(abs(s - t) < IMPACT_GAP_S for s in near)
+
+    def _send(self, perf: Performance, t: float) -> None:
         self._encoding = True
         self._seq += 1
-        self.server.submit(self._encode, self._seq, perf.pose(now_s + self.lead_s))
+        bisect.insort(self._sent, t)
+        del self._sent[:-16]
+        self.server.submit(self._encode, self._seq, perf.pose(t))
 
     def _encode(self, seq: int, pose: BandPose) -> None:
         try:

@@ -242,25 +242,29 @@ function showFrames(T) {
   const a = frames[i], b = frames[i + 1];
   if (i > 1) frames.splice(0, i - 1); // keep one older frame
   if (T > frames[frames.length - 1].t) stats.lateDraws++;
+  // interpolate each kind whose instance count is the same in both frames; a kind whose
+  // count changed (a string starting to vibrate adds segments) shows the nearer frame
   let w = 0;
-  const same = b && a.counts.every((c, k) => c === b.counts[k]);
-  if (same && T > a.t) w = Math.min(1, (T - a.t) / (b.t - a.t));
-  let off = 0;
+  if (b && T > a.t) w = Math.min(1, (T - a.t) / (b.t - a.t));
+  let offA = 0, offB = 0;
   stats.instances = 0;
   kinds.forEach((kind, k) => {
-    const n = a.counts[k];
+    const near = b && w >= 0.5 ? b : a;
+    const offNear = near === a ? offA : offB;
+    const n = near.counts[k];
     const d = ensureDynamic(kind, n);
     const dst = d.model.array;
-    if (w > 0) {
+    if (b && w > 0 && a.counts[k] === b.counts[k]) {
       for (let j = 0; j < n * 16; j++) {
-        const x = a.model[off * 16 + j];
-        dst[j] = x + (b.model[off * 16 + j] - x) * w;
+        const x = a.model[offA * 16 + j];
+        dst[j] = x + (b.model[offB * 16 + j] - x) * w;
       }
-    } else dst.set(a.model.subarray(off * 16, (off + n) * 16));
-    d.color.array.set((w >= 0.5 ? b : a).color.subarray(off * 4, (off + n) * 4));
+    } else dst.set(near.model.subarray(offNear * 16, (offNear + n) * 16));
+    d.color.array.set(near.color.subarray(offNear * 4, (offNear + n) * 4));
     d.model.needsUpdate = true; d.color.needsUpdate = true;
     d.mesh.geometry.instanceCount = n;
-    off += n;
+    offA += a.counts[k];
+    if (b) offB += b.counts[k];
     stats.instances += n;
   });
 }

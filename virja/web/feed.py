@@ -23,6 +23,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from virja.chords import chord_name
 from virja.events import Beat, Chord, Event
 from virja.render.scene import band_scene, static_scene
 from virja.web.fanout import Message
@@ -38,16 +39,6 @@ DEFAULT_FPS = 30.0
 DEFAULT_LEAD_S = 0.1  # frames are sampled this far ahead: delivery and one frame period
 KEEP_STATUS = 16  # recent beats and chords a new viewer is told
 IMPACT_GAP_S = 0.004  # an impact this close to a frame already sent gets no frame of its own
-
-NOTE_NAMES = ("C", "Db", "D", "Eb", "E", "F", "Gb", "G", "Ab", "A", "Bb", "B")
-
-
-def chord_name(chord: Chord) -> str:
-    """``Bb7``, ``Cm7/G``: the root's name, the quality as sent, a slash bass."""
-    name = NOTE_NAMES[chord.root % 12] + chord.quality
-    if chord.bass is not None and chord.bass % 12 != chord.root % 12:
-        name += "/" + NOTE_NAMES[chord.bass % 12]
-    return name
 
 
 def status_message(event: Event) -> str | None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -187,15 +187,54 @@ class MotionTiming:
 
 @dataclass(frozen=True)
 class Timing:
+    """Impact alignment and inter-stroke times.  ``moves[(a, b)]``: the least time
+    for one hand from a stroke on piece ``a`` to a stroke on piece ``b``, from the
+    distance between them (:func:`hand_moves`); none given: the target's
+    ``min_interval_s``."""
+
     reference_spb: float
     rest_s: float
     kinds: dict[str, MotionTiming]
+    moves: dict[tuple[str, str], float] = field(default_factory=dict)
 
     def get(self, kind: str) -> MotionTiming:
         try:
             return self.kinds[kind]
         except KeyError:
             raise ConfigError(f"timing table has no motion kind {kind!r}") from None
+
+    def gap(self, prev: str | None, piece: str) -> float:
+        """The least time between a hand's stroke on ``prev`` and its next on ``piece``:
+        the piece's ``min_interval_s`` (rebound doubles on one piece), or the move
+        between two pieces if that is longer."""
+        base = self.get(piece).min_interval_s
+        if prev is None or prev == piece:
+            return base
+        return max(base, self.moves.get((prev, piece), 0.0))
+
+    @property
+    def max_gap(self) -> float:
+        """The longest :meth:`gap`: a stroke older than this constrains nothing."""
+        return max(
+            max((mt.min_interval_s for mt in self.kinds.values()), default=0.0),
+            max(self.moves.values(), default=0.0),
+        )
+
+
+def hand_moves(base_s: float, speed_m_s: float) -> dict[tuple[str, str], float]:
+    """``base_s`` + distance / ``speed_m_s`` between the strike points of every two hand
+    pieces of the drawn kit (virja.geometry): lifting off one piece and landing on the
+    other is quick, travelling across the kit is not."""
+    from virja.geometry import GEOMETRY
+
+    kit = GEOMETRY.kit
+    pts = {p: kit.strike_point(p) for p in HAND_PIECES}
+    return {
+        (a, b): base_s + float(math.dist(pts[a], pts[b])) / speed_m_s
+        for a in HAND_PIECES
+        for b in HAND_PIECES
+        if a != b
+    }
 
 
 @dataclass(frozen=True)
@@ -258,7 +297,9 @@ def parse_kit(data: dict[str, Any], *, where: str = "drum_kit.toml") -> DrumKit:
         entry = _table(value, where, k)
         piece = _str(_need(entry, where, "piece", f"{k}."), where, f"{k}.piece")
         limb = _opt_str(entry.get("limb"), where, f"{k}.limb")
-        if limb is None and piece not in HAND_PIECES:
+        if piece == "none" and limb is not None:
+            raise ConfigError(f"{where}: drum note {key}: piece \"none\" (nobody) takes no limb")
+        if limb is None and piece not in HAND_PIECES and piece != "none":
             raise ConfigError(f"{where}: drum note {key}: piece {piece!r} is not a hand piece")
         if limb is not None and (piece, limb) not in FOOT_KINDS:
             raise ConfigError(f"{where}: drum note {key}: {piece} cannot be played by {limb}")
@@ -320,7 +361,17 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
     rest_s = _float(_need(data, where, "rest_s"), where, "rest_s")
     if rest_s < 0:
         raise ConfigError(f"{where}: rest_s must be >= 0, got {rest_s}")
-    return Timing(60.0 / bpm, rest_s, kinds)
+    moves: dict[tuple[str, str], float] = {}
+    if "hand_move" in data:
+        hm = _table(data["hand_move"], where, "hand_move")
+        base_s = _float(_need(hm, where, "base_s", "hand_move."), where, "hand_move.base_s")
+        speed = _float(
+            _need(hm, where, "speed_m_s", "hand_move."), where, "hand_move.speed_m_s"
+        )
+        if base_s < 0 or speed <= 0:
+            raise ConfigError(f"{where}: hand_move needs base_s >= 0 and speed_m_s > 0")
+        moves = hand_moves(base_s, speed)
+    return Timing(60.0 / bpm, rest_s, kinds, moves)
 
 
 _TIMING_FIELDS = ("anticipation_s", "min_anticipation_s", "min_interval_s")

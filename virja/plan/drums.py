@@ -5,10 +5,13 @@ and two motions at the same instant ordered left hand first, then right.  Its
 cost is ``table[none][m1] + sum table[m_(k-1)][m_k]``, where the row is
 "none" for the first motion and for any motion at least ``rest_s`` after the
 previous one (docs/scheduler.md).  Constraints: one hand strikes one piece at
-a time; the two strokes of a simultaneous pair go to different hands; a hand
-strikes again only after the new motion's ``min_interval_s``.  A stroke that
+a time; the two strokes of a group (notes within the grouping window) go to
+different hands; a hand strikes again only after :meth:`Timing.gap` from its
+last stroke: the piece's ``min_interval_s`` on the same piece (rebound doubles,
+taps, buzz), longer the farther it has to travel to another piece.  A stroke that
 no hand can make in time is dropped at a penalty (``drop_penalty`` + 9 -
-priority), so dropping happens only when nothing else is feasible.
+priority), so dropping happens only when nothing else is feasible.  Ties go to
+the right hand (the time-keeping hand keeps the time).
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """
@@ -34,34 +37,39 @@ class Stroke:
 
     piece: str
     priority: int
+    dt: float = 0.0  # its note's time after the group's time (within the grouping window)
 
 
 @dataclass(frozen=True)
 class HandGroup:
-    """Hand strokes sounding together (at most two distinct pieces)."""
+    """Hand strokes meant together (at most two); ``time`` is the earliest note's."""
 
     time: float
     strokes: tuple[Stroke, ...]
 
 
-# (previous motion index or None, its time, right hand's last stroke, left hand's last stroke)
-HandState = tuple[int | None, float | None, float | None, float | None]
-START: HandState = (None, None, None, None)
+# (previous motion index or None, its time, right hand's last stroke time, left hand's
+# last stroke time, right hand's last piece, left hand's last piece)
+HandState = tuple[int | None, float | None, float | None, float | None, str | None, str | None]
+START: HandState = (None, None, None, None, None, None)
 Assignment = tuple[Hand | None, ...]  # per stroke; None = dropped
 
 
 def options(group: HandGroup) -> list[Assignment]:
-    """Every way to give the group's strokes to hands, drops last (the tie order)."""
+    """Every way to give the group's strokes to hands, drops last (the tie order:
+    the right hand first, so that equal costs keep the time-keeping hand playing)."""
+    if not group.strokes:  # a group of rebounds only: nothing for the hands to decide
+        return [()]
     if len(group.strokes) == 1:
-        return [(LEFT,), (RIGHT,), (None,)]
+        return [(RIGHT,), (LEFT,), (None,)]
     if len(group.strokes) == 2:
         return [
-            (LEFT, RIGHT),
             (RIGHT, LEFT),
-            (LEFT, None),
+            (LEFT, RIGHT),
             (RIGHT, None),
-            (None, LEFT),
+            (LEFT, None),
             (None, RIGHT),
+            (None, LEFT),
             (None, None),
         ]
     raise ValueError(f"a hand group has 1 or 2 strokes, got {len(group.strokes)}")
@@ -79,13 +87,16 @@ def transition(
     Per-stroke cost is the table cost that stroke paid (0 for a dropped one);
     the increment adds the drop penalties.
     """
-    prev, prev_t, t_right, t_left = state
+    prev, prev_t, t_right, t_left, p_right, p_left = state
     t = group.time
     for stroke, hand in zip(group.strokes, assign, strict=True):
         if hand is None:
             continue
-        last = t_right if hand == RIGHT else t_left
-        if last is not None and t - last < timing.get(stroke.piece).min_interval_s - TIME_EPS_S:
+        last, lp = (t_right, p_right) if hand == RIGHT else (t_left, p_left)
+        if (
+            last is not None
+            and t + stroke.dt - last < timing.gap(lp, stroke.piece) - TIME_EPS_S
+        ):
             return None
     row = prev if prev is not None and prev_t is not None and t - prev_t < timing.rest_s else None
     order = sorted(
@@ -103,27 +114,27 @@ def transition(
         total += c
         row = m
         if hand == RIGHT:
-            t_right = t
+            t_right, p_right = t + group.strokes[i].dt, group.strokes[i].piece
         else:
-            t_left = t
+            t_left, p_left = t + group.strokes[i].dt, group.strokes[i].piece
     for stroke, hand in zip(group.strokes, assign, strict=True):
         if hand is None:
             total += drop_penalty(costs, stroke)
     if order:
         prev, prev_t = row, t
-    return total, (prev, prev_t, t_right, t_left), tuple(per)
+    return total, (prev, prev_t, t_right, t_left, p_right, p_left), tuple(per)
 
 
 def _canonical(state: HandState, t: float, timing: Timing, max_interval: float) -> HandState:
     """Forget what no later group (at or after ``t``) can be affected by."""
-    prev, prev_t, t_right, t_left = state
+    prev, prev_t, t_right, t_left, p_right, p_left = state
     if prev_t is not None and t - prev_t >= timing.rest_s:
         prev, prev_t = None, None
     if t_right is not None and t - t_right >= max_interval:
-        t_right = None
+        t_right, p_right = None, None
     if t_left is not None and t - t_left >= max_interval:
-        t_left = None
-    return (prev, prev_t, t_right, t_left)
+        t_left, p_left = None, None
+    return (prev, prev_t, t_right, t_left, p_right, p_left)
 
 
 @dataclass(frozen=True)
@@ -138,21 +149,20 @@ class HandSolution:
 class _Option:
     """One assignment of a group, precompiled: what :func:`transition` computes each time.
 
-    ``played`` lists the played strokes left hand first as ``(is_right, motion, min
-    interval - eps, stroke index)``; ``penalty`` is the sum of the drop penalties.
+    ``played`` lists the played strokes left hand first as ``(is_right, motion, piece,
+    dt, stroke index)``; ``penalty`` is the sum of the drop penalties.
     """
 
     assign: Assignment
-    played: tuple[tuple[bool, int, float, int], ...]
+    played: tuple[tuple[bool, int, str, float, int], ...]
     penalty: float
 
 
-# A played option flattened for the solver's inner loop: (option index, interval the
-# right hand needs since its last stroke, the same for the left hand (-inf for a hand
-# that does not play), motion that ends the group (the next row), right hand plays,
-# left hand plays, penalty, first played motion, table cost first -> second played
-# motion (0.0 for one stroke)).
-_Played = tuple[int, float, float, int, bool, bool, float, int, float]
+# A played option flattened for the solver's inner loop: (option index, the right
+# hand's piece and its stroke's dt (None, 0.0 when the right hand does not play), the
+# same for the left hand, motion that ends the group (the next row), penalty, first
+# played motion, table cost first -> second played motion (0.0 for one stroke)).
+_Played = tuple[int, str | None, float, str | None, float, int, float, int, float]
 
 
 @dataclass(frozen=True, slots=True)
@@ -176,26 +186,23 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                 penalty += drop_penalty(costs, stroke)
             else:
                 played.append(
-                    (
-                        hand == RIGHT,
-                        costs.index(stroke.piece, hand),
-                        timing.get(stroke.piece).min_interval_s - TIME_EPS_S,
-                        i,
-                    )
+                    (hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, stroke.dt, i)
                 )
         played.sort(key=lambda p: p[0])  # left (False) first
         opts.append(_Option(assign, tuple(played), penalty))
         if played:
-            need = {is_right: min_int for is_right, _m, min_int, _i in played}
+            hand_of = {is_right: (piece, dt) for is_right, _m, piece, dt, _i in played}
+            r_piece, r_dt = hand_of.get(True, (None, 0.0))
+            l_piece, l_dt = hand_of.get(False, (None, 0.0))
             first, last = played[0][1], played[-1][1]
             flat.append(
                 (
                     k,
-                    need.get(True, -math.inf),
-                    need.get(False, -math.inf),
+                    r_piece,
+                    r_dt,
+                    l_piece,
+                    l_dt,
                     last,
-                    True in need,
-                    False in need,
                     penalty,
                     first,
                     costs.table[first][last] if len(played) == 2 else 0.0,
@@ -272,12 +279,12 @@ def solve(
     tests/plan/test_solver_equivalence.py keeps the plain DP and checks that every
     result (assignments, per-stroke costs, states, total) is equal on random input.
     """
-    max_interval = max(mt.min_interval_s for mt in timing.kinds.values())
+    max_interval = timing.max_gap
+    gap = timing.gap
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
     inf = math.inf
-    played_t_ok = max_interval > 0.0  # a hand that plays now is remembered (unless all 0)
     layer: list[HandState] = [state]  # the states reached, in first-reached order
     accs: list[float] = [0.0]  # least objective reaching each
     # back-pointers per group: the previous layer's state and the option index; the
@@ -287,14 +294,14 @@ def solve(
     compiled_all = []
     for group in groups:
         t = group.time
-        played_t = t if played_t_ok else None
         comp = _compiled(costs, timing, group.strokes)
         compiled_all.append(comp)
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
         played_opts = comp.played
         moves_by_hands: dict[
-            tuple[float | None, float | None], tuple[list[_Move], float | None, float | None]
+            tuple[float | None, float | None, str | None, str | None],
+            tuple[list[_Move], float | None, float | None, str | None, str | None],
         ] = {}
         index: dict[HandState, int] = {}  # next layer: state -> its number
         nxt: list[HandState] = []
@@ -303,26 +310,39 @@ def solve(
         back_s: list[int] = []
         back_k: list[int] = []
         for sid, acc in enumerate(accs):
-            prev, prev_t, t_right, t_left = layer[sid]
-            hands = (t_right, t_left)
+            prev, prev_t, t_right, t_left, p_right, p_left = layer[sid]
+            hands = (t_right, t_left, p_right, p_left)
             entry = moves_by_hands.get(hands)
             if entry is None:
                 # hand times kept after the group (_canonical): forgotten once no
                 # later group can be constrained by them
-                keep_r = None if t_right is not None and t - t_right >= max_interval else t_right
-                keep_l = None if t_left is not None and t - t_left >= max_interval else t_left
+                keep_r, keep_pr = (
+                    (None, None)
+                    if t_right is not None and t - t_right >= max_interval
+                    else (t_right, p_right)
+                )
+                keep_l, keep_pl = (
+                    (None, None)
+                    if t_left is not None and t - t_left >= max_interval
+                    else (t_left, p_left)
+                )
                 since_r = inf if t_right is None else t - t_right
                 since_l = inf if t_left is None else t - t_left
                 moves: list[_Move] = []
-                for k, need_r, need_l, last, right, left, penalty, first, pair in played_opts:
-                    if since_r < need_r or since_l < need_l:
+                for k, r_piece, r_dt, l_piece, l_dt, last, penalty, first, pair in played_opts:
+                    if r_piece is not None and since_r + r_dt < gap(p_right, r_piece) - TIME_EPS_S:
                         continue
-                    new = (
-                        last,
-                        t,
-                        played_t if right else keep_r,
-                        played_t if left else keep_l,
-                    )
+                    if l_piece is not None and since_l + l_dt < gap(p_left, l_piece) - TIME_EPS_S:
+                        continue
+                    nr, npr = keep_r, keep_pr
+                    if r_piece is not None:
+                        nr = None if t - (t + r_dt) >= max_interval else t + r_dt
+                        npr = None if nr is None else r_piece
+                    nl, npl = keep_l, keep_pl
+                    if l_piece is not None:
+                        nl = None if t - (t + l_dt) >= max_interval else t + l_dt
+                        npl = None if nl is None else l_piece
+                    new = (last, t, nr, nl, npr, npl)
                     nid = index.get(new)
                     if nid is None:
                         nid = index[new] = len(nxt)
@@ -331,8 +351,8 @@ def solve(
                         back_s.append(0)
                         back_k.append(0)
                     moves.append((k, penalty, first, pair, nid))
-                entry = moves_by_hands[hands] = (moves, keep_r, keep_l)
-            moves, keep_r, keep_l = entry
+                entry = moves_by_hands[hands] = (moves, keep_r, keep_l, keep_pr, keep_pl)
+            moves, keep_r, keep_l, keep_pr, keep_pl = entry
             recent = prev_t is not None and t - prev_t < rest_s
             row = table[prev] if prev is not None and recent else none_row
             for k, penalty, first, pair, nid in moves:
@@ -344,9 +364,9 @@ def solve(
                     back_k[nid] = k
             # dropping every stroke: the previous motion is forgotten once rest_s old
             dropped: HandState = (
-                (None, None, keep_r, keep_l)
+                (None, None, keep_r, keep_l, keep_pr, keep_pl)
                 if prev_t is not None and t - prev_t >= rest_s
-                else (prev, prev_t, keep_r, keep_l)
+                else (prev, prev_t, keep_r, keep_l, keep_pr, keep_pl)
             )
             nid = index.get(dropped)
             if nid is None:
@@ -384,7 +404,7 @@ def solve(
             else None
         )
         per = [0.0] * len(groups[gi].strokes)
-        for _is_right, m, _min_int, i in opt.played:
+        for _is_right, m, _piece, _dt, i in opt.played:
             per[i] = table[costs.none_row if r is None else r][m]
             r = m
         assigns.append(opt.assign)

@@ -31,7 +31,18 @@ from virja.tempo import DEFAULT_SECONDS_PER_BEAT, Tempo
 
 log = logging.getLogger(__name__)
 
-GROUP_EPS_S = 0.001  # notes this close sound together (one group, one stroke per piece)
+GROUP_EPS_S = 0.001  # notes this close sound together (one stroke per piece and limb)
+# The drummer's hands take notes within this window of a group's first note as meant
+# together (humanised "simultaneous" hits lie 2-30 ms apart; a flam's grace note leads
+# its main note by 15-30 ms): one decision for the group, each note at its own time.
+HAND_WINDOW_S = 0.030
+# Notes of one piece this close are one stroke heard twice (head and rim, a pad's
+# double trigger): the later ones ride on the first stroke, each at its own time.
+SAME_STROKE_S = 0.010
+# A note this soft on the piece a limb has just struck, sooner than the limb could
+# strike again, is that stroke's rebound (a beater or stick bouncing off the head
+# once more), heard at its own time and played by the same stroke.
+REBOUND_VELOCITY = 16
 HISTORY = 64  # fixed hand strokes kept for notes that arrive out of order
 MAX_BEATS_KEPT = 1024  # tempo history: minutes of beats, far past the 10 s horizon
 MAX_REPORTED = 10_000  # dropped and moved notes kept for the report (totals are counted)
@@ -80,14 +91,44 @@ class _Chain:
     plan: list[Any] | None = None
 
 
-def _groups(recs: list[_Rec]) -> list[list[_Rec]]:
+def _groups(recs: list[_Rec], window: float = GROUP_EPS_S) -> list[list[_Rec]]:
+    """``recs`` in time order, cut into groups of notes within ``window`` of the
+    group's first note."""
     out: list[list[_Rec]] = []
     for r in sorted(recs, key=lambda r: (r.note.time_s, r.seq)):
-        if out and r.note.time_s - out[-1][0].note.time_s <= GROUP_EPS_S:
+        if out and r.note.time_s - out[-1][0].note.time_s <= window + drums_mod.TIME_EPS_S:
             out[-1].append(r)
         else:
             out.append([r])
     return out
+
+
+def _window(chain: str) -> float:
+    return GROUP_EPS_S if chain == "bass" else HAND_WINDOW_S
+
+
+def velocity_priority(priority: int, velocity: int) -> int:
+    """A note's priority weighed by its velocity (lower = more important): a ghost
+    note (velocity < 40) gives way first, a soft one (< 64) next, an accent (>= 100)
+    is kept before a plain stroke of its piece."""
+    if velocity < 40:
+        return priority + 3
+    if velocity < 64:
+        return priority + 1
+    if velocity >= 100:
+        return max(0, priority - 1)
+    return priority
+
+
+@dataclass(frozen=True, slots=True)
+class _HandGroupPlan:
+    """A hand group prepared for the solver: its (at most two) strokes, the notes of
+    each, bounces (index of the stroke they ride on, notes) and notes beyond two hands."""
+
+    group: drums_mod.HandGroup
+    kept: list[list[_Rec]]
+    bounces: list[tuple[int, list[_Rec]]]
+    extra: list[_Rec]
 
 
 class OnlinePlanner:
@@ -108,6 +149,7 @@ class OnlinePlanner:
         self._dropped: deque[DroppedNote] = deque(maxlen=MAX_REPORTED)
         self._moved: deque[MovedNote] = deque(maxlen=MAX_REPORTED)
         self._counts: Counter[str] = Counter()
+        self._unplayed: Counter[str] = Counter()  # per instrument: not a kit drummer's
         self._seq = 0
 
     # -- inputs ---------------------------------------------------------------
@@ -154,7 +196,7 @@ class OnlinePlanner:
     def flush(self) -> list[PlannedNote]:
         """Everything still held, planned and fixed, in start order."""
         for chain in self._chains.values():
-            groups = _groups(chain.pending)
+            groups = _groups(chain.pending, _window(chain.name))
             self._fix(chain, groups, len(groups))
         out = sorted(self._outbox, key=lambda p: (p.start, p.time))
         self._outbox = []
@@ -164,7 +206,10 @@ class OnlinePlanner:
     def report(self) -> PlanReport:
         """Notes dropped or moved so far."""
         return PlanReport(
-            tuple(self._dropped), tuple(self._moved), tuple(sorted(self._counts.items()))
+            tuple(self._dropped),
+            tuple(self._moved),
+            tuple(sorted(self._counts.items())),
+            tuple(sorted(self._unplayed.items())),
         )
 
     @property
@@ -203,6 +248,9 @@ class OnlinePlanner:
                 self._counts["dropped_unmapped"] += 1
                 log.info("drum note %d not in the kit map: dropped", note.note)
                 return None
+            if dn.piece == "none":  # percussion no kit drummer plays: routed to nobody
+                self._unplayed[dn.name or f"note {note.note}"] += 1
+                return None
             chain = dn.limb or "hands"
             kind = (
                 dn.piece if dn.limb is None else ("kick" if dn.piece == "kick" else "hihat_pedal")
@@ -220,7 +268,7 @@ class OnlinePlanner:
         for chain in self._chains.values():
             if chain.min_start > now_s:  # nothing pending has started (or none pending)
                 continue
-            groups = _groups(chain.pending)
+            groups = _groups(chain.pending, _window(chain.name))
             started = [i for i, g in enumerate(groups) if min(r.start for r in g) <= now_s]
             if started:
                 self._fix(chain, groups, started[-1] + 1)
@@ -309,43 +357,161 @@ class OnlinePlanner:
 
     # drums: hands -------------------------------------------------------------
 
-    def _hand_group(self, group: list[_Rec]) -> tuple[drums_mod.HandGroup, dict[str, list[_Rec]]]:
-        by_piece: dict[str, list[_Rec]] = {}
-        for r in group:
-            assert r.drum is not None
-            by_piece.setdefault(r.drum.piece, []).append(r)
+    def _rebounds(self, chain: _Chain) -> set[int]:
+        """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
+        note on the same piece, fixed or pending, within its ``min_interval_s`` (a
+        buzz: soft rebounds of one pressed stroke)."""
+        strokes: dict[str, list[float]] = {}
+        for ft, p in chain.fixed:
+            if p.piece is not None:
+                strokes.setdefault(p.piece, []).append(ft)
+        for r in chain.pending:
+            if r.drum is not None:
+                strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
+        out = set()
+        for r in chain.pending:
+            if r.drum is None or r.note.velocity >= REBOUND_VELOCITY:
+                continue
+            t = r.note.time_s
+            reach = self.config.timing.get(r.drum.piece).min_interval_s
+            if any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ())):
+                out.add(r.seq)
+        return out
 
-        # best priority first, then the piece heard first
-        rank = {
-            piece: (min(r.drum.priority for r in recs if r.drum), min(r.seq for r in recs))
-            for piece, recs in by_piece.items()
-        }
-        pieces = sorted(by_piece, key=rank.__getitem__)
-        strokes = tuple(drums_mod.Stroke(p, rank[p][0]) for p in pieces)
-        return drums_mod.HandGroup(group[0].note.time_s, strokes), by_piece
+    def _hand_group(self, group: list[_Rec], t0: float) -> _HandGroupPlan:
+        """The strokes of a group: notes of one piece within GROUP_EPS_S are one stroke.
+
+        The two most important strokes (velocity-weighed priority, then the earlier)
+        are planned; a further stroke on a piece already planned is a bounce of the
+        nearest planned stroke there (a buzz or a drag's second note, same hand); a
+        third distinct piece within the window is more than two hands can strike.
+        """
+        if not group:
+            return _HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
+        clusters: list[list[_Rec]] = []
+        for r in sorted(group, key=lambda r: (r.note.time_s, r.seq)):
+            assert r.drum is not None
+            same = next(
+                (
+                    c
+                    for c in clusters
+                    if c[0].drum is not None
+                    and c[0].drum.piece == r.drum.piece
+                    and r.note.time_s - c[0].note.time_s <= SAME_STROKE_S
+                ),
+                None,
+            )
+            if same is None:
+                clusters.append([r])
+            else:
+                same.append(r)
+
+        def rank(c: list[_Rec]) -> tuple[int, float, int]:
+            prio = min(velocity_priority(r.drum.priority, r.note.velocity) for r in c if r.drum)
+            return (prio, c[0].note.time_s, c[0].seq)
+
+        ranked = sorted(clusters, key=rank)
+        kept = ranked[:2]
+        bounces: list[tuple[int, list[_Rec]]] = []
+        extra: list[_Rec] = []
+        for c in ranked[2:]:
+            piece = c[0].drum.piece if c[0].drum else ""
+            near = [
+                (abs(k[0].note.time_s - c[0].note.time_s), i)
+                for i, k in enumerate(kept)
+                if k[0].drum is not None and k[0].drum.piece == piece
+            ]
+            if near:
+                bounces.append((min(near)[1], c))
+            else:
+                extra.extend(c)
+        strokes = tuple(
+            drums_mod.Stroke(
+                c[0].drum.piece if c[0].drum else "", rank(c)[0], c[0].note.time_s - t0
+            )
+            for c in kept
+        )
+        return _HandGroupPlan(drums_mod.HandGroup(t0, strokes), kept, bounces, extra)
 
     def _fix_hands(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
-        prepared = [self._hand_group(g) for g in groups]
-        trimmed = [drums_mod.HandGroup(hg.time, hg.strokes[:2]) for hg, _ in prepared]
+        rebounds = self._rebounds(chain)
+        prepared = [
+            self._hand_group([r for r in g if r.seq not in rebounds], g[0].note.time_s) for g in groups
+        ]
         if chain.plan is None:
-            sol = drums_mod.solve(self.config.costs, self.config.timing, chain.state, trimmed)
+            sol = drums_mod.solve(
+                self.config.costs, self.config.timing, chain.state, [p.group for p in prepared]
+            )
             chain.plan = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
         for gi in range(n_groups):
-            hg, by_piece = prepared[gi]
+            hp = prepared[gi]
             assignment, stroke_costs, state = chain.plan[gi]
-            for si, stroke in enumerate(hg.strokes):
-                recs = by_piece[stroke.piece]
-                if si >= 2:
-                    for r in recs:
-                        self._drop(r, "too_many_hands")
-                    continue
+            for r in hp.extra:
+                self._drop(r, "too_many_hands")
+            # three or more pieces at once: whatever else gives way, gives way to that
+            slow: DropReason = "too_many_hands" if hp.extra else "too_fast"
+            late_rebounds = [r for r in groups[gi] if r.seq in rebounds]
+            for si, stroke in enumerate(hp.group.strokes):
+                recs = hp.kept[si]
                 hand = assignment[si]
-                if hand is None:
-                    for r in recs:
-                        self._drop(r, "too_fast")
+                bounces = [r for k, c in hp.bounces if k == si for r in c]
+                other = 1 - si
+                if (
+                    hand is None
+                    and len(hp.group.strokes) == 2
+                    and hp.group.strokes[other].piece == stroke.piece
+                    and assignment[other] is not None
+                ):
+                    # no second hand for it, but the first is on the same piece: a
+                    # rebound of that stroke (a drag, a buzz, a pad's double trigger)
+                    hand = assignment[other]
+                    assert hand is not None
+                    for r in recs + bounces:
+                        self._emit_bounce(chain, r, stroke.piece, hand)
                     continue
-                self._emit_stroke(chain, recs, stroke.piece, hand, stroke_costs[si])
+                if hand is None:
+                    for r in recs + bounces:
+                        self._drop(r, slow)
+                    continue
+                now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
+                self._emit_stroke(chain, now, stroke.piece, hand, stroke_costs[si])
+                for r in recs[len(now) :] + bounces:
+                    self._emit_bounce(chain, r, stroke.piece, hand)
+            for r in late_rebounds:
+                self._emit_rebound(chain, r)
             chain.state = state
+
+    def _emit_rebound(self, chain: _Chain, rec: _Rec) -> None:
+        """``rec`` rides on the latest stroke before it on its piece (see
+        :meth:`_rebounds`); dropped if that stroke was not played."""
+        assert rec.drum is not None
+        t = rec.note.time_s
+        by = next(
+            (
+                p
+                for ft, p in reversed(chain.fixed)
+                if p.piece == rec.drum.piece and ft < t
+            ),
+            None,
+        )
+        if by is None or by.limb is None:
+            self._drop(rec, "too_fast")
+        else:
+            self._emit_bounce(chain, rec, rec.drum.piece, by.limb)
+
+    def _emit_bounce(self, chain: _Chain, rec: _Rec, piece: str, limb: str) -> None:
+        """A note played by the rebound of a stroke of ``limb`` on ``piece`` within the
+        grouping window: its own impact time, no cost of its own."""
+        self._emit(
+            chain,
+            rec,
+            limb=_limb(limb),
+            piece=piece,
+            string=None,
+            fret=None,
+            motion=f"{piece}_{limb}",
+            cost=0.0,
+        )
 
     def _emit_stroke(
         self, chain: _Chain, recs: list[_Rec], piece: str, limb: str, cost: float
@@ -368,6 +534,8 @@ class OnlinePlanner:
     # drums: feet --------------------------------------------------------------
 
     def _fix_foot(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
+        """One stroke per group (notes within the window of its first); the group's
+        later notes are the beater's or the cymbals' bounce (a double trigger)."""
         for group in groups[:n_groups]:
             first = group[0]
             assert first.drum is not None
@@ -375,10 +543,16 @@ class OnlinePlanner:
             min_int = self.config.timing.get(first.kind).min_interval_s
             if chain.state is not None and t - chain.state < min_int - drums_mod.TIME_EPS_S:
                 for r in group:
-                    self._drop(r, "too_fast")
+                    if r.note.velocity < REBOUND_VELOCITY:
+                        self._emit_bounce(chain, r, first.drum.piece, chain.name)
+                    else:
+                        self._drop(r, "too_fast")
                 continue
             chain.state = t
-            self._emit_stroke(chain, group, first.drum.piece, chain.name, 0.0)
+            now = [r for r in group if r.note.time_s - t <= GROUP_EPS_S]
+            self._emit_stroke(chain, now, first.drum.piece, chain.name, 0.0)
+            for r in group[len(now) :]:
+                self._emit_bounce(chain, r, first.drum.piece, chain.name)
 
     # notes that arrive after later notes of their chain were fixed ---------------
 

@@ -130,12 +130,15 @@ class PlanReport:
 
     ``dropped`` and ``moved`` hold the most recent cases (a long-running daemon
     keeps a bounded number); ``counts``, when given, holds the totals since the
-    start, which :meth:`summary` reports.
+    start, which :meth:`summary` reports.  ``unplayed`` counts, per instrument
+    name, the drum-channel notes that no kit drummer plays (congas, shakers,
+    ...): routing sent them to nobody, so they are not drops.
     """
 
     dropped: tuple[DroppedNote, ...] = field(default_factory=tuple)
     moved: tuple[MovedNote, ...] = field(default_factory=tuple)
     counts: tuple[tuple[str, int], ...] | None = None
+    unplayed: tuple[tuple[str, int], ...] = field(default_factory=tuple)
 
     def summary(self) -> dict[str, int]:
         """Counts by kind: ``{"dropped": n, "moved": m, "dropped_<reason>": k, ...}``."""

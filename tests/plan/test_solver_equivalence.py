@@ -21,8 +21,9 @@ from virja.plan.drums import RIGHT, Assignment, HandGroup, HandSolution, HandSta
 def _reference_drums(
     costs: DrumCosts, timing: Timing, state: HandState, groups: Sequence[HandGroup]
 ) -> HandSolution:
-    """The plain DP over hand states (the solver as it was before it was sped up)."""
-    max_interval = max(mt.min_interval_s for mt in timing.kinds.values())
+    """The plain DP over hand states (the solver as it was before it was sped up; hand
+    states carry each hand's last piece, strokes their offset in the group)."""
+    max_interval = timing.max_gap
     rest_s, table, none_row = timing.rest_s, costs.table, costs.none_row
     best: dict[HandState, float] = {state: 0.0}
     backs: list[dict[HandState, tuple[HandState, int]]] = []
@@ -36,29 +37,30 @@ def _reference_drums(
                 if hand is None:
                     penalty += drums.drop_penalty(costs, stroke)
                 else:
-                    min_int = timing.get(stroke.piece).min_interval_s - drums.TIME_EPS_S
-                    plays.append((hand == RIGHT, costs.index(stroke.piece, hand), min_int, i))
+                    plays.append((hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, i))
             plays.sort(key=lambda p: p[0])  # left hand first
             compiled.append((assign, tuple(plays), penalty))
         compiled_all.append(compiled)
         nxt: dict[HandState, float] = {}
         back: dict[HandState, tuple[HandState, int]] = {}
         for st, acc in best.items():
-            prev, prev_t, t_right, t_left = st
+            prev, prev_t, t_right, t_left, p_right, p_left = st
             row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
             for k, (_assign, played, penalty) in enumerate(compiled):
                 row, tr, tl, total, ok = row0, t_right, t_left, acc + penalty, True
-                for is_right, m, min_int, _i in played:
-                    last = tr if is_right else tl
-                    if last is not None and t - last < min_int:
+                pr, pl = p_right, p_left
+                for is_right, m, piece, i in played:
+                    last, lp = (t_right, p_right) if is_right else (t_left, p_left)
+                    ts = t + group.strokes[i].dt
+                    if last is not None and ts - last < timing.gap(lp, piece) - drums.TIME_EPS_S:
                         ok = False
                         break
                     total += table[none_row if row is None else row][m]
                     row = m
                     if is_right:
-                        tr = t
+                        tr, pr = ts, piece
                     else:
-                        tl = t
+                        tl, pl = ts, piece
                 if not ok:
                     continue
                 if played:
@@ -68,10 +70,10 @@ def _reference_drums(
                 else:
                     np_, npt = prev, prev_t
                 if tr is not None and t - tr >= max_interval:
-                    tr = None
+                    tr, pr = None, None
                 if tl is not None and t - tl >= max_interval:
-                    tl = None
-                new = (np_, npt, tr, tl)
+                    tl, pl = None, None
+                new = (np_, npt, tr, tl, pr, pl)
                 old = nxt.get(new)
                 if old is None or total < old:
                     nxt[new] = total
@@ -95,7 +97,7 @@ def _reference_drums(
             else None
         )
         per = [0.0] * len(group.strokes)
-        for _is_right, m, _min_int, i in played:
+        for _is_right, m, _piece, i in played:
             per[i] = table[none_row if r is None else r][m]
             r = m
         assigns.append(assign)
@@ -131,21 +133,37 @@ def _random_case(
             )
             for k, v in timing.kinds.items()
         }
-        timing = Timing(timing.reference_spb, rng.choice([0.0, 0.1, 1.5]), kinds)
+        moves = rng.choice([{}, timing.moves])  # no moves: every gap is min_interval_s
+        timing = Timing(timing.reference_spb, rng.choice([0.0, 0.1, 1.5]), kinds, moves)
     state = drums.START
     if rng.random() < 0.3:  # a fixed state left by an earlier plan
+        t_right = rng.choice([None, -0.02, -0.1])
+        t_left = rng.choice([None, -0.01, -0.06])
         state = (
             rng.choice([None, rng.randrange(14)]),
             rng.choice([None, -0.05, -1.0]),
-            rng.choice([None, -0.02, -0.1]),
-            rng.choice([None, -0.01, -0.06]),
+            t_right,
+            t_left,
+            None if t_right is None else rng.choice(PIECES),
+            None if t_left is None else rng.choice(PIECES),
         )
     t = rng.choice([0.0, 3.0])
     groups = []
     for _ in range(rng.randint(0, 10)):
         t += rng.choice([0.0, 0.03, 0.0625, 0.07, 0.08, 0.125, 0.15, 0.25, 2.0])
-        pieces = rng.sample(PIECES, rng.choice([1, 2, 2]))
-        groups.append(HandGroup(t, tuple(Stroke(p, rng.randint(0, 12)) for p in pieces)))
+        n = rng.choice([0, 1, 2, 2, 2])
+        pieces = rng.sample(PIECES, n) if rng.random() < 0.8 else [rng.choice(PIECES)] * n
+        dts = sorted(rng.choice([0.0, 0.0, 0.01, 0.025, 0.03]) for _ in pieces)
+        if dts:
+            dts[0] = 0.0
+        groups.append(
+            HandGroup(
+                t,
+                tuple(
+                    Stroke(p, rng.randint(0, 12), dt) for p, dt in zip(pieces, dts, strict=True)
+                ),
+            )
+        )
     return costs, timing, state, groups
 
 

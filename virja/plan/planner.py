@@ -43,6 +43,11 @@ SAME_STROKE_S = 0.010
 # strike again, is that stroke's rebound (a beater or stick bouncing off the head
 # once more), heard at its own time and played by the same stroke.
 REBOUND_VELOCITY = 16
+# A soft hand note (a ghost note) this soon after another note on the same piece is
+# part of a buzz or press roll: the same hand presses, the stick bounces.
+BUZZ_VELOCITY = 40
+BUZZ_S = 0.050
+BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
 HISTORY = 64  # fixed hand strokes kept for notes that arrive out of order
 MAX_BEATS_KEPT = 1024  # tempo history: minutes of beats, far past the 10 s horizon
 MAX_REPORTED = 10_000  # dropped and moved notes kept for the report (totals are counted)
@@ -74,6 +79,8 @@ class _Rec:
     start: float = 0.0
     impact: float = 0.0
     late: bool = False
+    rebound: bool | None = None  # hands: decided once, the first time it is planned
+    to_foot: bool | None = None  # hands: a hi-hat note given to the left foot (decided once)
 
 
 @dataclass(slots=True)
@@ -368,15 +375,22 @@ class OnlinePlanner:
         for r in chain.pending:
             if r.drum is not None:
                 strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
-        out = set()
         for r in chain.pending:
-            if r.drum is None or r.note.velocity >= REBOUND_VELOCITY:
+            if r.rebound is not None:
+                continue
+            r.rebound = False
+            if r.drum is None or r.note.velocity >= BUZZ_VELOCITY:
+                continue
+            if r.drum.piece not in BUZZ_PIECES:  # a crash swings away: no rebound
                 continue
             t = r.note.time_s
             reach = self.config.timing.get(r.drum.piece).min_interval_s
-            if any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ())):
-                out.add(r.seq)
-        return out
+            if r.note.velocity >= REBOUND_VELOCITY:
+                reach = max(reach, BUZZ_S)
+            r.rebound = any(
+                0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ())
+            )
+        return {r.seq for r in chain.pending if r.rebound}
 
     def _hand_group(self, group: list[_Rec], t0: float) -> _HandGroupPlan:
         """The strokes of a group: notes of one piece within GROUP_EPS_S are one stroke.
@@ -435,8 +449,12 @@ class OnlinePlanner:
 
     def _fix_hands(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
         rebounds = self._rebounds(chain)
+        for g in groups:
+            self._decide_foot(g, rebounds)
+        aside = rebounds | {r.seq for r in chain.pending if r.to_foot}
         prepared = [
-            self._hand_group([r for r in g if r.seq not in rebounds], g[0].note.time_s) for g in groups
+            self._hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
+            for g in groups
         ]
         if chain.plan is None:
             sol = drums_mod.solve(
@@ -447,10 +465,14 @@ class OnlinePlanner:
             hp = prepared[gi]
             assignment, stroke_costs, state = chain.plan[gi]
             for r in hp.extra:
-                self._drop(r, "too_many_hands")
+                if not self._foot_chick(r):
+                    self._drop(r, "too_many_hands")
             # three or more pieces at once: whatever else gives way, gives way to that
             slow: DropReason = "too_many_hands" if hp.extra else "too_fast"
             late_rebounds = [r for r in groups[gi] if r.seq in rebounds]
+            for r in groups[gi]:
+                if r.to_foot and not self._foot_chick(r):
+                    self._drop(r, "too_many_hands")
             for si, stroke in enumerate(hp.group.strokes):
                 recs = hp.kept[si]
                 hand = assignment[si]
@@ -471,7 +493,8 @@ class OnlinePlanner:
                     continue
                 if hand is None:
                     for r in recs + bounces:
-                        self._drop(r, slow)
+                        if not self._foot_chick(r):
+                            self._drop(r, slow)
                     continue
                 now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
                 self._emit_stroke(chain, now, stroke.piece, hand, stroke_costs[si])
@@ -480,6 +503,72 @@ class OnlinePlanner:
             for r in late_rebounds:
                 self._emit_rebound(chain, r)
             chain.state = state
+
+    def _decide_foot(self, group: list[_Rec], rebounds: set[int]) -> None:
+        """Three or more hand pieces at once, one the hi-hat: the left foot takes the
+        hi-hat (a chick) if it is free, and the hands keep the rest."""
+        undecided = [r for r in group if r.to_foot is None]
+        if not undecided:
+            return
+        pieces = {r.drum.piece for r in group if r.drum is not None and r.seq not in rebounds}
+        crowded = len(pieces) >= 3 and "hihat" in pieces
+        for r in undecided:
+            r.to_foot = (
+                crowded
+                and r.seq not in rebounds
+                and r.drum is not None
+                and r.drum.piece == "hihat"
+                and self._foot_free(r.note.time_s)
+            )
+
+    def _foot_near(self) -> list[float]:
+        foot = self._chains["left_foot"]
+        near = [ft for ft, _p in foot.fixed] + [r.note.time_s for r in foot.pending]
+        if foot.state is not None:
+            near.append(foot.state)
+        return near
+
+    def _foot_free(self, t: float) -> bool:
+        """The left foot plays the hi-hat at ``t`` already, or can."""
+        near = self._foot_near()
+        min_int = self.config.timing.get("hihat_pedal").min_interval_s
+        return any(abs(ft - t) <= HAND_WINDOW_S for ft in near) or not any(
+            abs(ft - t) < min_int - drums_mod.TIME_EPS_S for ft in near
+        )
+
+    def _foot_chick(self, rec: _Rec) -> bool:
+        """A hi-hat note both hands are too busy for, played by the left foot (a chick
+        on the pedal) if the foot is free then or already plays the hi-hat then."""
+        if rec.drum is None or rec.drum.piece != "hihat":
+            return False
+        foot = self._chains["left_foot"]
+        t = rec.note.time_s
+        min_int = self.config.timing.get("hihat_pedal").min_interval_s
+        near = self._foot_near()
+        if any(abs(ft - t) <= HAND_WINDOW_S for ft in near):
+            shared = True  # the foot plays the hi-hat then: the note rides on that chick
+        elif any(abs(ft - t) < min_int - drums_mod.TIME_EPS_S for ft in near):
+            return False
+        else:
+            shared = False
+        a = align(
+            self.config.timing, "hihat_pedal", t, rec.known_s, self.seconds_per_beat_at(t)
+        )
+        rec.start, rec.impact, rec.late = a.start, a.impact, a.late
+        self._emit(
+            foot,
+            rec,
+            limb="left_foot",
+            piece="hihat",
+            string=None,
+            fret=None,
+            motion="hihat_left_foot",
+            cost=0.0,
+        )
+        if not shared and (foot.state is None or t > foot.state):
+            foot.state = t
+        self._counts["foot_chick"] += 1
+        return True
 
     def _emit_rebound(self, chain: _Chain, rec: _Rec) -> None:
         """``rec`` rides on the latest stroke before it on its piece (see
@@ -535,12 +624,22 @@ class OnlinePlanner:
 
     def _fix_foot(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
         """One stroke per group (notes within the window of its first); the group's
-        later notes are the beater's or the cymbals' bounce (a double trigger)."""
-        for group in groups[:n_groups]:
+        later notes are the beater's or the cymbals' bounce (a double trigger).  A
+        very soft note (REBOUND_VELOCITY) that a stroke follows sooner than the limb
+        could strike twice is the beater touching the head before that stroke."""
+        for gi, group in enumerate(groups[:n_groups]):
             first = group[0]
             assert first.drum is not None
             t = first.note.time_s
             min_int = self.config.timing.get(first.kind).min_interval_s
+            if (
+                gi + 1 < len(groups)
+                and all(r.note.velocity < REBOUND_VELOCITY for r in group)
+                and groups[gi + 1][0].note.time_s - t < min_int - drums_mod.TIME_EPS_S
+            ):
+                for r in group:
+                    self._emit_bounce(chain, r, first.drum.piece, chain.name)
+                continue
             if chain.state is not None and t - chain.state < min_int - drums_mod.TIME_EPS_S:
                 for r in group:
                     if r.note.velocity < REBOUND_VELOCITY:

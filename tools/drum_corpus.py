@@ -72,7 +72,11 @@ def main(argv: list[str] | None = None) -> int:
         total += n
         if d:
             per_file.append((sum(d.values()), path, d))
+    clean = len(files) - sum(
+        1 for _n, _p, d in per_file if any(r not in ALLOWED for r in d)
+    )
     print(f"files: {len(files)}  drum notes: {total}  late: {late}")
+    print(f"files with no kit note dropped (but for {', '.join(sorted(ALLOWED))}): {clean}")
     print(f"dropped: {sum(drops.values())}" + "".join(f"; {r}: {n}" for r, n in sorted(drops.items())))
     print(
         f"played by nobody (not a kit instrument): {sum(nobody.values())}"

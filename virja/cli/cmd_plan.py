@@ -122,6 +122,11 @@ def _summary(planned: list[PlannedNote], report: PlanReport) -> list[str]:
         f"dropped: {len(report.dropped)}"
         + "".join(f"; {who} {reason}: {n}" for (who, reason), n in sorted(drops.items()))
     )
+    if report.unplayed:
+        lines.append(
+            "routed to nobody (no kit drummer plays them): "
+            + "; ".join(f"{name} {n}" for name, n in report.unplayed)
+        )
     lines.append(
         f"moved by octaves: {len(report.moved)}"
         + "".join(f"; {m.note.note} -> {m.played_note} at {m.note.time_s:.3f} s"

@@ -7,20 +7,33 @@ minus the planned impact), the contact error at the impact (distance to the
 drum head, cymbal, pedal, or string point in virja.geometry; should be under
 1 cm), and the continuity of the motion: the largest frame-to-frame change of
 a limb joint's angular velocity inside connection intervals versus within
-single clips, and the time per pose.
+single clips, and the time per pose.  For the drummer also (virja.motion.
+drummer_report): wrist speed p99 and max, the largest hand jump between frames
+at 30 fps, the torso's turn, collisions by pair, hi-hat state agreement with
+the notes, and the notes dropped by reason.  With --json: one JSON object with
+every figure.
 
 Example:  virja motion-report song.mid
           virja motion-report song.mid --max-seconds 20 --per-note
+          virja motion-report song.mid --json
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import time
+from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from virja.cli.common import finite_float
 from virja.errors import ConfigError, InputFileError
+
+if TYPE_CHECKING:
+    from virja.motion.drummer_report import DrummerFigures
+    from virja.motion.metrics import MotionReport, NoteCheck
+    from virja.plan.types import PlannedNote
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,14 +56,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--fps", type=finite_float, default=120.0, help="sampling rate for continuity (default 120)"
     )
     parser.add_argument("--per-note", action="store_true", help="also print one line per note")
+    parser.add_argument("--json", action="store_true", help="one JSON object with every figure")
 
 
 def run(args: argparse.Namespace) -> int:
     from virja.events import NoteOn
     from virja.midifile import read_midi
     from virja.motion.band import BandAnimator
+    from virja.motion.drummer_report import measure_drummer
     from virja.motion.metrics import CONTACT_TOLERANCE_M, measure
-    from virja.plan import plan_notes
+    from virja.plan import default_config, plan_notes_with_report
     from virja.routing import Router, route_all
 
     path = Path(args.input)
@@ -67,7 +82,9 @@ def run(args: argparse.Namespace) -> int:
         for who, ev in route_all(session.events, router)
         if isinstance(ev, NoteOn) and ev.time_s <= args.max_seconds
     ]
-    planned = plan_notes(notes, session.tempo_map, lookahead_beats=args.lookahead_beats)
+    planned, report = plan_notes_with_report(
+        notes, session.tempo_map, lookahead_beats=args.lookahead_beats
+    )
     if not planned:
         print(
             f"{path}: no bass or drum notes in the first {args.max_seconds:g} s; nothing to measure"
@@ -79,6 +96,11 @@ def run(args: argparse.Namespace) -> int:
     for p in planned:
         animator.add_planned(p)
     rep = measure(animator, planned, fps=args.fps)
+    kit = default_config().kit
+    drummer = measure_drummer(
+        animator, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=args.fps
+    )
+    drops = Counter(d.reason for d in report.dropped if d.performer == "drums")
     t0 = time.perf_counter()
     n = 200
     start = min(p.start for p in planned)
@@ -86,6 +108,13 @@ def run(args: argparse.Namespace) -> int:
         animator.pose(start + i / 60.0)
     pose_ms = (time.perf_counter() - t0) * 1e3 / n
 
+    if args.json:
+        print(
+            json.dumps(
+                _json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)
+            )
+        )
+        return 0
     if args.per_note:
         print(f"{'impact s':>9} {'motion':<22} {'contact mm':>10} {'fret mm':>8} {'timing ms':>9}")
         for c in rep.notes:
@@ -109,4 +138,88 @@ def run(args: argparse.Namespace) -> int:
         f"connections {rep.continuity_connection:.1f} rad/s, within clips {rep.continuity_within:.1f} rad/s"
     )
     print(f"pose time (both players): {pose_ms:.2f} ms per frame")
+    for line in _drummer_table(rep, drummer, drops):
+        print(line)
     return 0
+
+
+def _split(rep: MotionReport) -> dict[str, list[NoteCheck]]:
+    out: dict[str, list[NoteCheck]] = {"drums": [], "bass": []}
+    for c in rep.notes:
+        out["bass" if c.motion.startswith("pluck") else "drums"].append(c)
+    return out
+
+
+def _figure(checks: list[NoteCheck]) -> dict[str, float | int]:
+    contact = [c.contact_m for c in checks] + [
+        c.fret_contact_m for c in checks if c.fret_contact_m is not None
+    ]
+    return {
+        "notes": len(checks),
+        "contact_max_mm": round(max(contact, default=0.0) * 1e3, 3),
+        "contact_mean_mm": round(float(sum(contact) / len(contact)) * 1e3, 3) if contact else 0.0,
+        "timing_max_ms": round(max((abs(c.timing_s) for c in checks), default=0.0) * 1e3, 1),
+    }
+
+
+def _json(
+    path: Path,
+    planned: list[PlannedNote],
+    rep: MotionReport,
+    drummer: DrummerFigures,
+    drops: Counter[str],
+    unplayed: dict[str, int],
+    pose_ms: float,
+) -> dict[str, Any]:
+    split = _split(rep)
+    return {
+        "file": str(path),
+        "late": sum(p.late for p in planned),
+        "drums": {
+            **_figure(split["drums"]),
+            **drummer.to_json(),
+            "dropped": dict(sorted(drops.items())),
+            "routed_to_nobody": unplayed,
+        },
+        "bass": _figure(split["bass"]),
+        "continuity_connection_rad_s": round(rep.continuity_connection, 2),
+        "continuity_within_rad_s": round(rep.continuity_within, 2),
+        "pose_ms": round(pose_ms, 3),
+    }
+
+
+def _drummer_table(
+    rep: MotionReport, drummer: DrummerFigures, drops: Counter[str]
+) -> list[str]:
+    """The drummer's figures against the targets of issue 15."""
+    d = _figure(_split(rep)["drums"])
+    agree = drummer.hihat_agreement
+    hits = {k: v for k, v in drummer.collisions.items() if v}
+    rows = [
+        ("contact at impact (max)", f"{d['contact_max_mm']:.2f} mm", "< 10 mm"),
+        ("timing error (max)", f"{d['timing_max_ms']:.1f} ms", "0 ms"),
+        ("wrist speed p99", f"{drummer.wrist_speed_p99:.2f} m/s", "<= 5 m/s"),
+        ("wrist speed max", f"{drummer.wrist_speed_max:.2f} m/s", "<= 8 m/s"),
+        ("largest hand jump at 30 fps", f"{drummer.hand_jump_30fps_m * 100:.1f} cm", "<= 15 cm"),
+        ("torso turn range", f"{drummer.torso_range_deg:.1f} deg", ">= 3 deg"),
+        (
+            "collisions",
+            ", ".join(f"{k} {v}" for k, v in sorted(hits.items())) or "0",
+            "0",
+        ),
+        (
+            "hi-hat agreement",
+            "-" if agree is None else f"{agree * 100:.1f} % of {drummer.hihat_notes}",
+            "100 %",
+        ),
+        (
+            "dropped",
+            ", ".join(f"{k} {v}" for k, v in sorted(drops.items())) or "0",
+            "0 (but too_many_hands)",
+        ),
+    ]
+    w0 = max(len(r[0]) for r in rows)
+    w1 = max(len(r[1]) for r in rows)
+    out = ["drummer:"]
+    out += [f"  {a:<{w0}}  {b:<{w1}}  target {c}" for a, b, c in rows]
+    return out

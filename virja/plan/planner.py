@@ -45,7 +45,7 @@ SAME_STROKE_S = 0.010
 REBOUND_VELOCITY = 16
 # A soft hand note (a ghost note) this soon after another note on the same piece is
 # part of a buzz or press roll: the same hand presses, the stick bounces.
-BUZZ_VELOCITY = 40
+BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
 BUZZ_S = 0.050
 BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
 HISTORY = 64  # fixed hand strokes kept for notes that arrive out of order

@@ -27,7 +27,9 @@ from virja.routing import Router, route_all
 ALLOWED = {"too_many_hands"}
 
 
-def plan_file(path: str, lookahead: float = 1.0) -> tuple[str, Counter[str], Counter[str], int, int]:
+def plan_file(
+    path: str, lookahead: float = 1.0
+) -> tuple[str, Counter[str], Counter[str], int, int]:
     session = read_midi(path)
     router = Router.for_session(session)
     notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
@@ -72,12 +74,12 @@ def main(argv: list[str] | None = None) -> int:
         total += n
         if d:
             per_file.append((sum(d.values()), path, d))
-    clean = len(files) - sum(
-        1 for _n, _p, d in per_file if any(r not in ALLOWED for r in d)
-    )
+    clean = len(files) - sum(1 for _n, _p, d in per_file if any(r not in ALLOWED for r in d))
     print(f"files: {len(files)}  drum notes: {total}  late: {late}")
     print(f"files with no kit note dropped (but for {', '.join(sorted(ALLOWED))}): {clean}")
-    print(f"dropped: {sum(drops.values())}" + "".join(f"; {r}: {n}" for r, n in sorted(drops.items())))
+    print(
+        f"dropped: {sum(drops.values())}" + "".join(f"; {r}: {n}" for r, n in sorted(drops.items()))
+    )
     print(
         f"played by nobody (not a kit instrument): {sum(nobody.values())}"
         + "".join(f"; {k}: {n}" for k, n in sorted(nobody.items()))

@@ -21,7 +21,24 @@ GROOVES = (
     "ModernJazz", "MellowJazz", "NiteJazz", "Ballad", "BossaNova", "JazzWaltz",
 )  # fmt: skip
 TEMPOS = (60, 90, 120, 150, 180, 210, 240, 270, 300)
-CHORDS = "Bb6 G7 Cm7 F7 Dm7 G7 Cm7 F7 Bb7 Bb7 Eb6 Ebm6 Dm7 G7 Cm7 F7".split()
+CHORDS = [
+    "Bb6",
+    "G7",
+    "Cm7",
+    "F7",
+    "Dm7",
+    "G7",
+    "Cm7",
+    "F7",
+    "Bb7",
+    "Bb7",
+    "Eb6",
+    "Ebm6",
+    "Dm7",
+    "G7",
+    "Cm7",
+    "F7",
+]
 
 
 def song(groove: str, tempo: int) -> str:

@@ -159,9 +159,7 @@ def _random_case(
         groups.append(
             HandGroup(
                 t,
-                tuple(
-                    Stroke(p, rng.randint(0, 12), dt) for p, dt in zip(pieces, dts, strict=True)
-                ),
+                tuple(Stroke(p, rng.randint(0, 12), dt) for p, dt in zip(pieces, dts, strict=True)),
             )
         )
     return costs, timing, state, groups

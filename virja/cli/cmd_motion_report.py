@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
     drummer = measure_drummer(
         animator, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=args.fps
     )
-    drops = Counter(d.reason for d in report.dropped if d.performer == "drums")
+    drops: Counter[str] = Counter(d.reason for d in report.dropped if d.performer == "drums")
     t0 = time.perf_counter()
     n = 200
     start = min(p.start for p in planned)
@@ -109,11 +109,7 @@ def run(args: argparse.Namespace) -> int:
     pose_ms = (time.perf_counter() - t0) * 1e3 / n
 
     if args.json:
-        print(
-            json.dumps(
-                _json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)
-            )
-        )
+        print(json.dumps(_json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)))
         return 0
     if args.per_note:
         print(f"{'impact s':>9} {'motion':<22} {'contact mm':>10} {'fret mm':>8} {'timing ms':>9}")
@@ -188,9 +184,7 @@ def _json(
     }
 
 
-def _drummer_table(
-    rep: MotionReport, drummer: DrummerFigures, drops: Counter[str]
-) -> list[str]:
+def _drummer_table(rep: MotionReport, drummer: DrummerFigures, drops: Counter[str]) -> list[str]:
     """The drummer's figures against the targets of issue 15."""
     d = _figure(_split(rep)["drums"])
     agree = drummer.hihat_agreement

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -41,6 +42,13 @@ LEG_SEGMENTS = (("LeftUpLeg", "LeftLeg"), ("LeftLeg", "LeftFoot"))
 LEG_SEGMENTS_R = (("RightUpLeg", "RightLeg"), ("RightLeg", "RightFoot"))
 CLOSED_ARTICULATIONS = frozenset({"closed", "closed_edge", "pedal"})
 OPEN_ARTICULATIONS = frozenset({"open", "open_edge"})
+
+
+class DrumNoteLike(PlannedNoteLike, Protocol):
+    """A planned note with its MIDI note number (for the hi-hat's articulation)."""
+
+    @property
+    def note(self) -> int: ...
 
 
 @dataclass
@@ -113,9 +121,7 @@ def _segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.nda
     return np.asarray(np.linalg.norm(diff, axis=1))
 
 
-def _collisions(
-    animator: BandAnimator, pos: np.ndarray, stk: np.ndarray
-) -> dict[str, int]:
+def _collisions(animator: BandAnimator, pos: np.ndarray, stk: np.ndarray) -> dict[str, int]:
     kit = animator.geometry.kit
     out: dict[str, int] = {}
     d = _segment_distance(stk[:, 0, 0], stk[:, 0, 1], stk[:, 1, 0], stk[:, 1, 1])
@@ -142,10 +148,10 @@ def _collisions(
                 rel = pt - piece.centre
                 h = rel @ piece.normal
                 radial = np.linalg.norm(rel - h[:, None] * piece.normal, axis=1)
-                inside |= (h < 0) & (h > -piece.depth) & (radial < piece.radius)  # type: ignore[union-attr]
+                inside |= (h < 0) & (h > -piece.depth) & (radial < piece.radius)
         out[f"leg-{name}"] = _runs(inside)
     toes = np.stack([pos[:, _SK.index("LeftToe"), 1], pos[:, _SK.index("RightToe"), 1]], axis=1)
-    out["foot-floor"] = _runs((toes < -0.01).any(axis=1))
+    out["foot-floor"] = _runs(np.asarray((toes < -0.01).any(axis=1)))
     return out
 
 
@@ -156,7 +162,7 @@ def _yaw_deg(rot: np.ndarray) -> np.ndarray:
 
 def measure_drummer(
     animator: BandAnimator,
-    planned: Sequence[PlannedNoteLike],
+    planned: Sequence[DrumNoteLike],
     articulation: Mapping[int, str | None],
     *,
     fps: float = 120.0,

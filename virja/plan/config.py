@@ -298,7 +298,7 @@ def parse_kit(data: dict[str, Any], *, where: str = "drum_kit.toml") -> DrumKit:
         piece = _str(_need(entry, where, "piece", f"{k}."), where, f"{k}.piece")
         limb = _opt_str(entry.get("limb"), where, f"{k}.limb")
         if piece == "none" and limb is not None:
-            raise ConfigError(f"{where}: drum note {key}: piece \"none\" (nobody) takes no limb")
+            raise ConfigError(f'{where}: drum note {key}: piece "none" (nobody) takes no limb')
         if limb is None and piece not in HAND_PIECES and piece != "none":
             raise ConfigError(f"{where}: drum note {key}: piece {piece!r} is not a hand piece")
         if limb is not None and (piece, limb) not in FOOT_KINDS:
@@ -365,9 +365,7 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
     if "hand_move" in data:
         hm = _table(data["hand_move"], where, "hand_move")
         base_s = _float(_need(hm, where, "base_s", "hand_move."), where, "hand_move.base_s")
-        speed = _float(
-            _need(hm, where, "speed_m_s", "hand_move."), where, "hand_move.speed_m_s"
-        )
+        speed = _float(_need(hm, where, "speed_m_s", "hand_move."), where, "hand_move.speed_m_s")
         if base_s < 0 or speed <= 0:
             raise ConfigError(f"{where}: hand_move needs base_s >= 0 and speed_m_s > 0")
         moves = hand_moves(base_s, speed)

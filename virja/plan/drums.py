@@ -93,10 +93,7 @@ def transition(
         if hand is None:
             continue
         last, lp = (t_right, p_right) if hand == RIGHT else (t_left, p_left)
-        if (
-            last is not None
-            and t + stroke.dt - last < timing.gap(lp, stroke.piece) - TIME_EPS_S
-        ):
+        if last is not None and t + stroke.dt - last < timing.gap(lp, stroke.piece) - TIME_EPS_S:
             return None
     row = prev if prev is not None and prev_t is not None and t - prev_t < timing.rest_s else None
     order = sorted(

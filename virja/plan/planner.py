@@ -387,9 +387,7 @@ class OnlinePlanner:
             reach = self.config.timing.get(r.drum.piece).min_interval_s
             if r.note.velocity >= REBOUND_VELOCITY:
                 reach = max(reach, BUZZ_S)
-            r.rebound = any(
-                0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ())
-            )
+            r.rebound = any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ()))
         return {r.seq for r in chain.pending if r.rebound}
 
     def _hand_group(self, group: list[_Rec], t0: float) -> _HandGroupPlan:
@@ -453,8 +451,7 @@ class OnlinePlanner:
             self._decide_foot(g, rebounds)
         aside = rebounds | {r.seq for r in chain.pending if r.to_foot}
         prepared = [
-            self._hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
-            for g in groups
+            self._hand_group([r for r in g if r.seq not in aside], g[0].note.time_s) for g in groups
         ]
         if chain.plan is None:
             sol = drums_mod.solve(
@@ -551,9 +548,7 @@ class OnlinePlanner:
             return False
         else:
             shared = False
-        a = align(
-            self.config.timing, "hihat_pedal", t, rec.known_s, self.seconds_per_beat_at(t)
-        )
+        a = align(self.config.timing, "hihat_pedal", t, rec.known_s, self.seconds_per_beat_at(t))
         rec.start, rec.impact, rec.late = a.start, a.impact, a.late
         self._emit(
             foot,
@@ -576,11 +571,7 @@ class OnlinePlanner:
         assert rec.drum is not None
         t = rec.note.time_s
         by = next(
-            (
-                p
-                for ft, p in reversed(chain.fixed)
-                if p.piece == rec.drum.piece and ft < t
-            ),
+            (p for ft, p in reversed(chain.fixed) if p.piece == rec.drum.piece and ft < t),
             None,
         )
         if by is None or by.limb is None:

@@ -28,5 +28,8 @@ def test_each_demo_plays_both_players(path: Path) -> None:
     )
     planned = run_schedule(perf, src.schedule)
     per = {who: sum(1 for p in planned if p.performer == who) for who in ("bass", "drums")}
-    assert per["bass"] >= 16 and per["drums"] >= 100, per
+    # MMA's ballad gives its percussion (shaker, cabasa, congas, triangles) much of
+    # the drum channel: no kit drummer plays that, so it goes to nobody (issue 15)
+    nobody = sum(n for _name, n in perf.planner.report.unplayed)
+    assert per["bass"] >= 16 and per["drums"] >= 30 and per["drums"] + nobody >= 100, per
     assert not any(p.late for p in planned)

@@ -19,7 +19,7 @@ import logging
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import IO, TYPE_CHECKING
+from typing import IO, TYPE_CHECKING, Protocol
 
 from virja.events import Beat, Chord, Event, NoteOff, NoteOn, Performer
 from virja.hud import HudTimeline
@@ -27,12 +27,22 @@ from virja.routing import Router
 from virja.tempo import Tempo
 
 if TYPE_CHECKING:
-    from virja.motion.band import BandAnimator
     from virja.motion.pose import BandPose
     from virja.plan.planner import OnlinePlanner
     from virja.plan.types import PlannedNote
 
 log = logging.getLogger(__name__)
+
+
+class PlanSink(Protocol):
+    """Where committed motions go: a :class:`~virja.motion.band.BandAnimator`, the
+    window's process (:class:`virja.live.viewer.Viewer`) or several
+    (:class:`virja.live.sinks.Fanout`).  A sink may also have ``note_off(performer,
+    event)`` and ``pose(time_s)``."""
+
+    def add_planned(self, p: PlannedNote) -> None: ...
+
+    def add_beat(self, beat: Beat) -> None: ...
 
 
 class Performance:
@@ -43,7 +53,7 @@ class Performance:
         *,
         router: Router,
         planner: OnlinePlanner,
-        animator: BandAnimator | None = None,
+        animator: PlanSink | None = None,
         plan_log: IO[str] | None = None,
     ) -> None:
         self.router = router
@@ -123,9 +133,11 @@ class Performance:
         return notes
 
     def pose(self, time_s: float) -> BandPose:
-        if self.animator is None:
-            raise RuntimeError("this performance has no animator")
-        return self.animator.pose(time_s)
+        pose = getattr(self.animator, "pose", None)
+        if pose is None:
+            raise RuntimeError("this performance has no animator to pose")
+        result: BandPose = pose(time_s)
+        return result
 
 
 @dataclass(frozen=True)

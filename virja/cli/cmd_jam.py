@@ -213,15 +213,17 @@ def run(args: argparse.Namespace) -> int:
         perf = build_performance(
             doc,
             plan_log=log_fh,
-            animate=not args.headless or bool(args.web),
+            animate=bool(args.web),  # poses here only for the browser; the window animates itself
             delay_s=opts.delay_s,
             config_path=args.config,
         )
         view = None
-        if not args.headless:
-            from virja.render.live import LiveView
+        if not args.headless:  # the window draws in its own process (see virja.live.viewer)
+            from virja.live.sinks import Fanout
+            from virja.live.viewer import Viewer, ViewerSpec
 
-            view = LiveView(title="virja jam")
+            view = Viewer(ViewerSpec(title="virja jam", fps=opts.fps), clock.now_s)
+            perf.animator = Fanout([s for s in (perf.animator, view) if s is not None])
             stack.callback(view.close)
         web = open_web(args, perf, clock.now_s)
         if web is not None:
@@ -291,20 +293,16 @@ def _loop(
             perf.advance(now)
             if web is not None:
                 web.publish(perf, now)
-                if view is None and perf.animator is not None:
-                    perf.animator.forget_before(now - 20.0)
-            if view is not None:
-                view.frame(perf, now)
-                if view.closed:
-                    break
-                if perf.animator is not None:
-                    perf.animator.forget_before(now - 20.0)
+                forget = getattr(perf.animator, "forget_before", None)
+                if forget is not None:
+                    forget(now - 20.0)
+            if view is not None and view.closed:
+                break
             midi_in.poll(now)
             if thru is not None:
                 thru.poll(now)
             if end is not None and now >= end:
                 break
             next_tick = now + tick_s
-            if view is None:
-                time.sleep(max(0.0, min(next_tick, end or next_tick) - now_s()))
+            time.sleep(max(0.0, min(next_tick, end or next_tick) - now_s()))
     return counts

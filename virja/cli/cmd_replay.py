@@ -21,6 +21,7 @@ import argparse
 import math
 import time
 from pathlib import Path
+from typing import Any
 
 from virja.cli.common import (
     SAMPLE_CHOICES,
@@ -96,57 +97,22 @@ def run(args: argparse.Namespace) -> int:
 
 def play(src: object, args: argparse.Namespace) -> int:
     from virja.input import PerformanceInput
-    from virja.motion.band import BandAnimator
     from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
-    from virja.session import Performance, RevealFeeder, run_schedule
+    from virja.session import Performance, run_schedule
 
     assert isinstance(src, PerformanceInput)
     plan_log = open_plan_log(args.plan_log)
     perf = Performance(
         router=make_router(args),
         planner=OnlinePlanner(load_plan_config(args.config)),
-        animator=None if args.headless and not args.web else BandAnimator(),
         plan_log=plan_log,
     )
-    feeder = RevealFeeder(src.schedule)
-    t0, t1 = src.default_span()
     try:
         if args.headless and not args.web:
             run_schedule(perf, src.schedule)
         else:
-            from virja.render.live import LiveView
-            from virja.render.offline import parse_size
-
-            view = None
-            if not args.headless:
-                view = LiveView(
-                    parse_size(args.size), title=f"virja replay {Path(args.input).name}"
-                )
-            wall0 = time.perf_counter()
-            web = open_web(args, perf, lambda: t0 + (time.perf_counter() - wall0))
-            if web is not None:
-                print(f"virja replay: web viewer at {web.url}", flush=True)
-            try:
-                while view is None or not view.closed:
-                    t = t0 + (time.perf_counter() - wall0)
-                    if t > t1:
-                        break
-                    feeder.until(perf, t)
-                    perf.advance(t)
-                    if web is not None:
-                        web.publish(perf, t)
-                    if view is not None:
-                        view.frame(perf, t)
-                    else:
-                        time.sleep(0.005)
-            finally:
-                if view is not None:
-                    view.close()
-                if web is not None:
-                    web.close()
-            feeder.until(perf, math.inf)
-            perf.finish()
+            play_live(perf, src, args)
     finally:
         if plan_log is not None:
             plan_log.close()
@@ -155,3 +121,67 @@ def play(src: object, args: argparse.Namespace) -> int:
         f"({perf.counts['planned_late']} late), {perf.counts['notes_not_the_bands']} not the band's"
     )
     return 0
+
+
+WINDOW_CHECK_S = 0.1  # the replay notices a closed window within this long
+
+
+def play_live(perf: Any, src: Any, args: argparse.Namespace) -> None:
+    """The recording in real time: this process feeds and plans, sleeping to the next
+    reveal, motion start or web frame; the window's own process draws (as in `serve`);
+    with --web the browsers' frames are posed here by an animator of our own."""
+    from virja.live.sinks import Fanout
+    from virja.live.timer import wake_in
+    from virja.live.viewer import Viewer, ViewerSpec
+    from virja.motion.band import BandAnimator
+    from virja.render.offline import parse_size
+    from virja.session import RevealFeeder
+
+    feeder = RevealFeeder(src.schedule)
+    t0, t1 = src.default_span()
+    wall0 = [time.monotonic()]
+
+    def now_s() -> float:
+        return float(t0 + (time.monotonic() - wall0[0]))
+
+    sinks = Fanout()
+    perf.animator = sinks
+    viewer = web = None
+    try:
+        if args.web:
+            sinks.add(BandAnimator())
+        if not args.headless:
+            spec = ViewerSpec(  # --fps is the video's rate; the window follows the display
+                parse_size(args.size),
+                f"virja replay {Path(args.input).name}",
+                samples=args.samples,
+                camera=args.camera,
+            )
+            viewer = Viewer(spec, now_s)
+            sinks.add(viewer)
+        web = open_web(args, perf, now_s)
+        if web is not None:
+            print(f"virja replay: web viewer at {web.url}", flush=True)
+        wall0[0] = time.monotonic()  # the recording starts once the window is open
+        if viewer is not None:
+            viewer.sync_clock()
+        while viewer is None or not viewer.closed:
+            t = now_s()
+            if t > t1:
+                break
+            feeder.until(perf, t)
+            perf.advance(t)
+            reveal = src.schedule[feeder.next].at_s if not feeder.done else math.inf
+            deadlines = [reveal, perf.planner.next_deadline(), t1, t + WINDOW_CHECK_S]
+            if web is not None:
+                web.publish(perf, t)
+                sinks.forget_before(t - 20.0)
+                deadlines.append(t + 1 / web.fps)
+            time.sleep(wake_in(deadlines, now_s()))
+    finally:
+        if viewer is not None:
+            viewer.close()
+        if web is not None:
+            web.close()
+    feeder.until(perf, math.inf)
+    perf.finish()

@@ -3,9 +3,11 @@
 Binds 127.0.0.1:50500 by default (anything wider is an explicit --listen);
 every datagram goes through the receiver (validation, signing, duplicates,
 horizon, lateness), the notes to the scheduler, the motions to the animator,
-and the band to a window (or nowhere with --headless).  Stops on SIGINT or
-SIGTERM, or after --duration, printing a summary: datagrams by kind, drops by
-reason, late notes, the clock offset.
+and the band to a window (or nowhere with --headless).  The window is drawn by
+its own process, so no frame ever delays receiving or planning.  Stops on
+SIGINT or SIGTERM, on closing the window, or after --duration, printing a
+summary: datagrams received and rejected, notes planned and dropped (and why),
+frames shown, the clock offset.
 
 examples:
   virja serve --headless --plan-log plan.jsonl --record session.pcap
@@ -31,8 +33,13 @@ from virja.config import load_config
 from virja.errors import ConfigError
 
 STATUS_EVERY_S = 5.0
-TICK_S = 0.005
-KEEP_MOTION_S = 20.0
+RECORDER_FLUSH_S = 0.1  # the recording is flushed this often while it is open
+CLOCK_SYNC_S = 1.0  # with --clock-server, the window's clock follows the estimate this often
+WEB_IDLE_S = 0.25  # with --web and nobody watching: how soon a new browser gets its first frame
+KEEP_MOTION_S = 20.0  # motions older than this are forgotten by an animator in this process
+# receiver drops that are counted after a datagram was accepted (per event or note);
+# every other reason rejects the whole datagram
+AFTER_ACCEPT = frozenset({"too_late", "beyond_horizon", "queue_full", "unknown_kind"})
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -89,6 +96,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--size", default="1280x720", metavar="WxH", help="window size (default 1280x720)"
     )
+    p.add_argument(
+        "--fps",
+        type=finite_float,
+        default=60.0,
+        metavar="N",
+        help="window frame rate where the display has no vsync (default 60)",
+    )
     p.add_argument("--quiet", action="store_true", help="no status line")
     add_web_arguments(p)
     add_routing_arguments(p)
@@ -103,6 +117,8 @@ class Daemon:
     clock: Any
     recorder: Any = None
     clock_client: Any = None
+    timer: Any = None
+    viewer: Any = None
     late_notes: int = 0
     started_s: float = field(default_factory=time.monotonic)
 
@@ -115,8 +131,10 @@ class Daemon:
                 band = True
             if rec.late and isinstance(rec.event, NoteOn):
                 self.late_notes += 1
-        if band:  # plan at once; other traffic waits for the next tick
+        if band:  # plan at once; other traffic waits for the next deadline
             self.perf.advance(now_s)
+        if self.timer is not None:  # a note may bring the next deadline closer
+            self.timer.poke()
 
     def tick(self) -> None:
         now_us = self.clock.now_us()
@@ -141,16 +159,35 @@ class Daemon:
 
     def summary(self) -> list[str]:
         st = self.receiver.stats
+        c = self.perf.counts
+        rejected = {k: v for k, v in st.dropped.items() if k not in AFTER_ACCEPT and v}
+        on_arrival = {k: v for k, v in st.dropped.items() if k in AFTER_ACCEPT and v}
+        plan = self.perf.planner.report.summary()
+        by_planner = {
+            k.removeprefix("dropped_"): v for k, v in plan.items() if k.startswith("dropped_") and v
+        }
+        band = c["notes_bass"] + c["notes_drums"]
         lines = [
-            f"datagrams: {st.datagrams} received, {st.accepted} accepted",
-            "by kind: " + (", ".join(f"{k} {v}" for k, v in sorted(st.by_kind.items())) or "none"),
-            "dropped: " + (", ".join(f"{k} {v}" for k, v in sorted(st.dropped.items())) or "none"),
-            f"notes: {self.perf.counts['planned']} planned, {self.late_notes} arrived late "
-            f"(played compressed), {self.perf.counts['notes_not_the_bands']} not the band's",
+            f"datagrams: {st.datagrams} received, {st.accepted} accepted, "
+            f"{st.datagrams - st.accepted} rejected" + _reasons(rejected),
+            "accepted by kind: "
+            + (", ".join(f"{k} {v}" for k, v in sorted(st.by_kind.items())) or "none"),
+            f"notes: {band} for the band ({c['notes_bass']} bass, {c['notes_drums']} drums), "
+            f"{c['planned']} planned ({self.late_notes} arrived late and were played "
+            f"compressed), {plan.get('dropped', 0)} dropped by the scheduler"
+            + _reasons(by_planner),
+            f"events dropped on arrival: {sum(on_arrival.values())}"
+            + _reasons(on_arrival, explain=True),
+            f"notes not the band's: {c['notes_not_the_bands']}",
         ]
-        summary = self.perf.planner.report.summary()
-        if summary:
-            lines.append("scheduler: " + ", ".join(f"{k} {v}" for k, v in summary.items()))
+        if plan.get("moved"):
+            lines.append(f"notes moved into the bass's range: {plan['moved']}")
+        if self.viewer is not None and self.viewer.stats is not None:
+            vs = self.viewer.stats
+            lines.append(
+                f"window: {vs.frames} frames shown, {vs.skipped} skipped as late"
+                + (" (vsync)" if vs.vsync else "")
+            )
         if self.clock_client is not None:
             est = self.clock_client.estimator.estimate()
             lines.append(
@@ -164,6 +201,24 @@ class Daemon:
         else:
             lines.append("clock offset: 0 (no --clock-server; local clock is the session clock)")
         return lines
+
+
+WHY = {
+    "too_late": "notes past --lateness-ms",
+    "beyond_horizon": "datagrams past --horizon",
+    "queue_full": "events over the queue",
+    "unknown_kind": "datagrams of a kind unknown",
+}
+
+
+def _reasons(counts: dict[str, int], *, explain: bool = False) -> str:
+    if not counts:
+        return ""
+    parts = [
+        f"{k} {v}" + (f" ({WHY[k]})" if explain and k in WHY else "")
+        for k, v in sorted(counts.items())
+    ]
+    return ": " + ", ".join(parts)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -191,7 +246,9 @@ def _report_clock_failure(task: asyncio.Task[Any]) -> None:
 
 async def serve(args: argparse.Namespace) -> int:
     from virja.clock import SessionClock
-    from virja.motion.band import BandAnimator
+    from virja.live.sinks import Fanout
+    from virja.live.timer import DeadlineTimer, wake_in
+    from virja.live.viewer import Viewer, ViewerSpec
     from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
     from virja.render.offline import parse_size
@@ -219,20 +276,30 @@ async def serve(args: argparse.Namespace) -> int:
     perf = Performance(
         router=make_router(args),
         planner=OnlinePlanner(load_plan_config(args.config)),
-        animator=BandAnimator(),
     )
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
+    if not 1 <= args.fps <= 1000:
+        raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
     daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_listener(host, port, protocol, group=args.group)
     bound = transport.get_extra_info("sockname")
-    view = web = None
+    viewer = web = None
+    sinks = Fanout()  # where committed motions go: the window's process, an animator for --web
     try:
         web = open_web(args, perf, lambda: clock.now_us() / 1e6)
-        if not args.headless:
-            from virja.render.live import LiveView
+        if web is not None:  # the browsers' frames are posed here, by an animator of our own
+            from virja.motion.band import BandAnimator
 
-            view = LiveView(parse_size(args.size), title=f"virja serve {host}:{port}")
+            sinks.add(BandAnimator())
+        if not args.headless:
+            viewer = Viewer(
+                ViewerSpec(parse_size(args.size), f"virja serve {host}:{port}", args.fps),
+                clock.now_s,
+            )
+            sinks.add(viewer)
+        perf.animator = sinks if sinks.sinks else None
+        daemon.viewer = viewer
         perf.plan_log = open_plan_log(args.plan_log)
         if args.record:
             # the recording names the address and port actually bound (port 0 picks one)
@@ -242,8 +309,8 @@ async def serve(args: argparse.Namespace) -> int:
             protocol.recorder = daemon.recorder = recorder
     except BaseException:
         transport.close()
-        if view is not None:
-            view.close()
+        if viewer is not None:
+            viewer.close()
         if web is not None:
             web.close()
         if perf.plan_log is not None:
@@ -271,24 +338,33 @@ async def serve(args: argparse.Namespace) -> int:
         tasks.append(clock_task)
     if args.duration is not None:
         loop.call_later(args.duration, stop.set)
+    if viewer is not None:  # the window closed (Esc, Q, its close box): stop
+        loop.add_reader(viewer.sentinel, stop.set)
+    timer = daemon.timer = DeadlineTimer()
 
     async def ticker() -> None:
-        last_status = time.monotonic()
+        """Wake at the next motion's start, a status line, a flush; or on a datagram."""
+        next_status = time.monotonic() + STATUS_EVERY_S
         while not stop.is_set():
+            timer.arm()
             daemon.tick()
-            if web is not None:
-                web.publish(perf, clock.now_us() / 1e6)
-            if view is not None:
-                now_s = clock.now_us() / 1e6
-                view.frame(perf, now_s)
-                if view.closed:
-                    stop.set()
-            if perf.animator is not None:
-                perf.animator.forget_before(clock.now_us() / 1e6 - KEEP_MOTION_S)
-            if not args.quiet and time.monotonic() - last_status >= STATUS_EVERY_S:
-                last_status = time.monotonic()
-                print(f"virja serve: {daemon.status()}", file=sys.stderr, flush=True)
-            await asyncio.sleep(TICK_S if view is None else 0)
+            now_s = clock.now_s()
+            deadlines = [perf.planner.next_deadline()]
+            if web is not None:  # a frame for the browsers when one is due
+                web.publish(perf, now_s)
+                sinks.forget_before(now_s - KEEP_MOTION_S)
+                deadlines.append(now_s + (1 / web.fps if web.server.viewers else WEB_IDLE_S))
+            if daemon.recorder is not None:
+                deadlines.append(now_s + RECORDER_FLUSH_S)
+            if viewer is not None and daemon.clock_client is not None:
+                viewer.sync_clock()
+                deadlines.append(now_s + CLOCK_SYNC_S)
+            if not args.quiet:
+                if time.monotonic() >= next_status:
+                    next_status = time.monotonic() + STATUS_EVERY_S
+                    print(f"virja serve: {daemon.status()}", file=sys.stderr, flush=True)
+                deadlines.append(now_s + next_status - time.monotonic())
+            await timer.sleep(wake_in(deadlines, clock.now_s()))
 
     tasks.append(asyncio.create_task(ticker()))
     try:
@@ -300,14 +376,16 @@ async def serve(args: argparse.Namespace) -> int:
             with contextlib.suppress(asyncio.CancelledError, Exception):
                 await t
         transport.close()
+        if viewer is not None:
+            loop.remove_reader(viewer.sentinel)
         daemon.tick()
         perf.finish()  # notes planned ahead of the stop are logged too, as replay logs them
         if daemon.recorder is not None:
             daemon.recorder.close()
         if plan_log is not None:
             plan_log.close()
-        if view is not None:
-            view.close()
+        if viewer is not None:
+            viewer.close()
         if web is not None:
             web.close()
     print("virja serve: stopped")

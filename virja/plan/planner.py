@@ -209,6 +209,15 @@ class OnlinePlanner:
         self._outbox = []
         return out
 
+    def next_deadline(self) -> float:
+        """The earliest time at which :meth:`poll` can return something new: the
+        start of a motion pending or planned but not started (inf when none).
+        A live timer sleeps until then (or until a note arrives)."""
+        t = min(c.min_start for c in self._chains.values())
+        if self._outbox:
+            t = min(t, min(p.start for p in self._outbox))
+        return t
+
     @property
     def report(self) -> PlanReport:
         """Notes dropped or moved so far."""

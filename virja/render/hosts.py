@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -117,7 +118,9 @@ class WindowHost:
     screenshot (PNG in the working folder), Esc or Q close.
     """
 
-    def __init__(self, size: tuple[int, int] = (1280, 720), title: str = "virja") -> None:
+    def __init__(
+        self, size: tuple[int, int] = (1280, 720), title: str = "virja", *, vsync: bool = True
+    ) -> None:
         import glfw
 
         if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
@@ -138,11 +141,16 @@ class WindowHost:
             glfw.terminate()
             raise NotAvailableError("glfw could not open an OpenGL 3.3 window")
         glfw.make_context_current(self.window)
-        glfw.swap_interval(0)
+        # vsync where the display has it (a swap then waits for the refresh); Xvfb and
+        # llvmpipe have none and return at once: the frame loop paces itself then
+        glfw.swap_interval(1 if vsync else 0)
         # GLX (glcontext can attach to a current context only through GLX).  Mesa
         # refuses a GLX context in a process that already made an EGL one (X
         # BadAccess), so a process draws either to a window or headless, not both.
         self.ctx = moderngl.create_context(require=330)
+        self._screen: moderngl.Framebuffer | None = None
+        self._screen_size = (0, 0)
+        self.last_swap_s = 0.0  # how long the last swap waited (vsync: up to a refresh)
         self.state = WindowState()
         self.on_screenshot: Callable[[NDArray[np.uint8]], None] | None = None
         glfw.set_key_callback(self.window, self._on_key)
@@ -204,20 +212,43 @@ class WindowHost:
         return bool(self.glfw.window_should_close(self.window))
 
     def framebuffer(self) -> moderngl.Framebuffer:
-        fb = self.ctx.detect_framebuffer()
-        return fb
+        """The window's own framebuffer (GL name 0) at the window's current size.
+
+        Always framebuffer 0: ``detect_framebuffer()`` without a name returns
+        whatever is bound, which after the first frame is the offscreen target
+        (the bug that froze the window after one frame).
+        """
+        size = tuple(self.glfw.get_framebuffer_size(self.window))
+        if self._screen is None or size != self._screen_size:
+            w, h = max(1, size[0]), max(1, size[1])
+            self.ctx.screen.use()
+            self.ctx.viewport = (0, 0, w, h)  # framebuffer 0 reports the viewport as its size
+            self._screen = self.ctx.detect_framebuffer(0)
+            self._screen_size = (size[0], size[1])
+        return self._screen
+
+    def read_window_rgb(self) -> NDArray[np.uint8]:
+        """The window's own pixels (its back buffer as last drawn), (h, w, 3), top row first."""
+        fb = self.framebuffer()
+        w, h = fb.size
+        return np.frombuffer(fb.read(components=3, alignment=1), np.uint8).reshape(h, w, 3)[::-1]
 
     def present(self, fps: float | None = None) -> None:
         if self.state.screenshot_requested and self.on_screenshot is not None:
             self.state.screenshot_requested = False
-            fb = self.framebuffer()
-            w, h = fb.size
-            img = np.frombuffer(fb.read(components=3, alignment=1), np.uint8).reshape(h, w, 3)[::-1]
-            self.on_screenshot(img)
+            self.on_screenshot(self.read_window_rgb())
+        started = time.perf_counter()
         self.glfw.swap_buffers(self.window)
+        self.last_swap_s = time.perf_counter() - started
         self.glfw.poll_events()
         if fps is not None:
             self.glfw.set_window_title(self.window, f"{self.title} — {fps:.0f} fps")
+
+    def refresh_rate(self) -> float | None:
+        """The primary monitor's refresh rate in Hz, when the display reports one."""
+        monitor = self.glfw.get_primary_monitor()
+        mode = self.glfw.get_video_mode(monitor) if monitor else None
+        return float(mode.refresh_rate) if mode and mode.refresh_rate > 0 else None
 
     def close(self) -> None:
         self.glfw.destroy_window(self.window)

@@ -1,45 +1,55 @@
-"""Live drawing in a window: one frame of a performance at the current time.
+"""Live drawing in a window: one pose of the band per call, on the window's thread.
 
-Used by ``serve``, ``replay`` (without --out) and ``jam``: the host is a glfw
-window, the timer the session clock (or a replay clock), the drawing the same
-:class:`~virja.render.renderer.Renderer` as offline.
+The window of ``serve``, ``replay`` and ``jam`` (driven from the viewer process,
+:mod:`virja.live.viewer`): a glfw window, the same
+:class:`~virja.render.renderer.Renderer` as offline, drawn offscreen and copied
+to the window's own framebuffer, then swapped.
 """
 
 from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
+from virja.motion.pose import BandPose
 from virja.render.hosts import OffscreenTarget, WindowHost
 from virja.render.images import write_png
 from virja.render.renderer import DrawList, Renderer
 from virja.render.scene import band_scene, static_scene
-from virja.session import Performance
 
 log = logging.getLogger(__name__)
 
+VSYNC_SWAP_FRACTION = 0.3  # swaps that wait this much of a refresh on average: vsync is on
+
 
 class LiveView:
-    """A window showing a performance; call :meth:`frame` as often as you like."""
+    """A window showing the band: :meth:`show` draws one pose and presents it."""
 
     def __init__(
-        self, size: tuple[int, int] = (1280, 720), title: str = "virja", samples: int = 1
+        self,
+        size: tuple[int, int] = (1280, 720),
+        title: str = "virja",
+        samples: int = 1,
+        *,
+        vsync: bool = True,
     ) -> None:
-        self.host = WindowHost(size, title)
+        self.host = WindowHost(size, title, vsync=vsync)
         self.samples = samples
         self.target: OffscreenTarget | None = None
-        self.lead_s = 0.0  # running estimate of one frame's drawing time
         self.renderer = Renderer(self.host.ctx)
         self.static: DrawList = static_scene()
         self.host.on_screenshot = self._save_screenshot
         self._fps_frames = 0
         self._fps_since = time.perf_counter()
         self.fps = 0.0
+        self._swap_s: list[float] = []
+        self.frames = 0
 
     def _save_screenshot(self, rgb: object) -> None:
-        import numpy as np
-
         path = Path(f"virja-{time.strftime('%Y%m%d-%H%M%S')}.png")
         assert isinstance(rgb, np.ndarray)
         write_png(path, rgb)
@@ -49,25 +59,27 @@ class LiveView:
     def closed(self) -> bool:
         return self.host.should_close
 
-    def frame(self, perf: Performance, time_s: float) -> None:
-        """Draw the band offscreen, copy it to the window, show it.
+    def refresh_s(self) -> float | None:
+        """The display's refresh period if swaps wait for it (vsync), else None."""
+        if len(self._swap_s) < 10:
+            return None
+        swaps = sorted(self._swap_s)
+        median = swaps[len(swaps) // 2]
+        rate = self.host.refresh_rate()
+        period = 1.0 / rate if rate else 1.0 / 60.0
+        return period if median >= VSYNC_SWAP_FRACTION * period else None
 
-        The pose drawn is the one at ``time_s`` plus the time a frame takes to draw
-        (a running estimate): the picture shows the moment at which it appears,
-        so an impact is on screen when its sound is due, not a frame later.
-        """
-        started = time.perf_counter()
+    def show(self, pose: BandPose, extra: Sequence[DrawList] = ()) -> None:
+        """Draw ``pose`` (and ``extra`` layers) offscreen, copy it to the window, swap."""
         fb = self.host.framebuffer()
         if self.target is None or self.target.size != fb.size:
             if self.target is not None:
                 self.target.release()
             self.target = OffscreenTarget(self.host.ctx, fb.size, samples=self.samples)
-        pose = perf.pose(time_s + self.lead_s)
-        self.renderer.draw([self.static, band_scene(pose)], self.host.state.camera, self.target.fbo)
+        layers = [self.static, band_scene(pose), *extra]
+        self.renderer.draw(layers, self.host.state.camera, self.target.fbo)
         self.host.ctx.copy_framebuffer(fb, self.target.fbo)
-        self.host.ctx.finish()
-        cost = time.perf_counter() - started
-        self.lead_s = min(0.1, 0.8 * self.lead_s + 0.2 * cost)
+        self.host.ctx.finish()  # the drawing is done: what the swap waits for is the display
         self._fps_frames += 1
         now = time.perf_counter()
         if now - self._fps_since >= 1.0:
@@ -75,6 +87,13 @@ class LiveView:
             self._fps_frames = 0
             self._fps_since = now
         self.host.present(self.fps if self.fps else None)
+        if len(self._swap_s) < 30:
+            self._swap_s.append(self.host.last_swap_s)
+        self.frames += 1
+
+    def poll(self) -> None:
+        """Handle window events (keys, mouse, close) between frames."""
+        self.host.glfw.poll_events()
 
     def close(self) -> None:
         if self.target is not None:

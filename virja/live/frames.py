@@ -1,0 +1,123 @@
+"""The viewer's frame loop: take what the planner committed, draw the pose of the
+moment each frame will be shown, paced to the display, missed frames skipped.
+
+Runs in the window's process (:mod:`virja.live.viewer`) and owns its animator:
+the planning side only sends committed items, so nothing is shared and no lock
+is held while drawing.  Frame consumers (:class:`FrameSink`: the window, or any
+later one) get every drawn pose.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from virja.live.pacing import FramePacer
+from virja.motion.pose import BandPose
+
+KEEP_MOTION_S = 20.0  # motions older than this are forgotten (memory stays flat)
+FORGET_EVERY = 60  # frames between forgets
+
+
+class FrameSink(Protocol):
+    """A consumer of drawn poses: ``show`` one frame; ``closed`` when it wants to stop."""
+
+    @property
+    def closed(self) -> bool: ...
+
+    def show(self, pose: BandPose) -> None: ...
+
+
+class Animator(Protocol):
+    def add_planned(self, p: Any) -> None: ...
+
+    def add_beat(self, beat: Any) -> None: ...
+
+    def pose(self, time_s: float) -> BandPose: ...
+
+    def forget_before(self, time_s: float) -> None: ...
+
+
+@dataclass
+class Inbox:
+    """Items from the planning side: ``get()`` returns the next or None when none."""
+
+    get: Callable[[], tuple[Any, ...] | None]
+
+
+class FrameLoop:
+    """Draws paced frames to ``sinks`` until a sink closes or a ``("stop",)`` arrives.
+
+    Time: ``monotonic()`` paces the frames; session time is ``anchor + monotonic()``
+    where ``anchor`` comes from the planning side (``("clock", anchor)``), so both
+    processes agree on the session clock (CLOCK_MONOTONIC is system-wide).
+    """
+
+    def __init__(
+        self,
+        animator: Animator,
+        sinks: Sequence[FrameSink],
+        inbox: Inbox,
+        pacer: FramePacer,
+        *,
+        anchor_s: float = 0.0,
+        monotonic: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+        alive: Callable[[], bool] = lambda: True,
+    ) -> None:
+        self.animator = animator
+        self.sinks = list(sinks)
+        self.inbox = inbox
+        self.pacer = pacer
+        self.anchor_s = anchor_s
+        self.monotonic = monotonic
+        self.sleep = sleep
+        self.alive = alive
+        self.stopped = False
+        self.received = 0
+
+    def drain(self) -> None:
+        """Everything the planning side sent so far, into the animator."""
+        while (item := self.inbox.get()) is not None:
+            kind = item[0]
+            if kind == "planned":
+                self.animator.add_planned(item[1])
+                self.received += 1
+            elif kind == "beat":
+                self.animator.add_beat(item[1])
+            elif kind == "off":
+                off = getattr(self.animator, "note_off", None)
+                if off is not None:
+                    off(item[1], item[2])
+            elif kind == "clock":
+                self.anchor_s = float(item[1])
+            elif kind == "stop":
+                self.stopped = True
+
+    @property
+    def done(self) -> bool:
+        return self.stopped or any(s.closed for s in self.sinks) or not self.alive()
+
+    def step(self) -> bool:
+        """Wait for the next slot, draw it; False when the loop should end."""
+        slot = self.pacer.next_slot(self.monotonic())
+        wait = slot.draw_at - self.monotonic()
+        if wait > 0:
+            self.sleep(wait)
+        self.drain()
+        if self.done:
+            return False
+        started = self.monotonic()
+        pose = self.animator.pose(self.anchor_s + slot.show_at)
+        for s in self.sinks:
+            s.show(pose)
+        self.pacer.drawn(started, self.monotonic())
+        if self.pacer.shown % FORGET_EVERY == 0:
+            self.animator.forget_before(self.anchor_s + started - KEEP_MOTION_S)
+        return True
+
+    def run(self) -> None:
+        while self.step():
+            pass

@@ -1,0 +1,201 @@
+"""The window in its own process, so that no frame can delay receiving or planning.
+
+Seen from the planning side, :class:`Viewer` is a plan sink: ``add_planned``,
+``add_beat`` and ``note_off`` put the item on a queue (never blocking: a feeder
+thread writes the pipe) and return.  The viewer process owns the glfw window,
+its GL context, an animator and the frame loop (:mod:`virja.live.frames`).
+Why a process and not a thread: moderngl holds the GIL through every GL call,
+including the waits for llvmpipe, so a drawing thread stalls a receiving
+thread for whole frames (measured: 170-300 ms); in its own process a frame
+only competes for a core, which the kernel hands to the woken receiver at once.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import multiprocessing as mp
+import os
+import queue
+import signal
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from virja.errors import NotAvailableError
+from virja.events import Beat, NoteOff, Performer
+from virja.plan.types import PlannedNote
+
+log = logging.getLogger(__name__)
+
+READY_TIMEOUT_S = 60.0
+ANCHOR_TOLERANCE_S = 1e-4
+
+
+@dataclass(frozen=True)
+class ViewerSpec:
+    """What the viewer process needs to open its window."""
+
+    size: tuple[int, int] = (1280, 720)
+    title: str = "virja"
+    fps: float = 60.0
+    samples: int = 1
+    camera: str = "front"
+    vsync: bool = True
+
+
+@dataclass(frozen=True)
+class ViewerStats:
+    frames: int = 0
+    skipped: int = 0
+    motions: int = 0
+    vsync: bool = False
+
+
+class Viewer:
+    """Starts the viewer process and waits until its window is open (or says why not).
+
+    ``now_s`` is the planning side's session clock; the viewer draws at
+    ``anchor + monotonic()`` with ``anchor = now_s() - monotonic()``, sent again by
+    :meth:`sync_clock` when the clock is corrected (``--clock-server``).
+    """
+
+    def __init__(
+        self,
+        spec: ViewerSpec,
+        now_s: Callable[[], float],
+        *,
+        ready_timeout_s: float = READY_TIMEOUT_S,
+    ) -> None:
+        if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+            raise NotAvailableError(
+                "no display for a window (DISPLAY is not set); use --headless, or run under Xvfb"
+            )
+        ctx = mp.get_context("spawn")
+        self.spec = spec
+        self._now_s = now_s
+        self._anchor: float | None = None
+        self._inbox: Any = ctx.Queue()
+        self._back: Any = ctx.Queue()
+        self.sync_clock()
+        self._proc = ctx.Process(
+            target=viewer_main,
+            args=(spec, self._inbox, self._back, os.getpid(), self._anchor),
+            name="virja-viewer",
+            daemon=True,
+        )
+        self._proc.start()
+        self.stats: ViewerStats | None = None
+        try:
+            msg = self._back.get(timeout=ready_timeout_s)
+        except queue.Empty:
+            self._kill()
+            raise NotAvailableError(
+                f"the window did not open within {ready_timeout_s:g} s"
+            ) from None
+        if msg[0] != "ready":
+            self._proc.join(timeout=10)
+            raise NotAvailableError(str(msg[1]))
+
+    # -- the plan sink ---------------------------------------------------------
+    def add_planned(self, p: PlannedNote) -> None:
+        self._inbox.put(("planned", p))
+
+    def add_beat(self, beat: Beat) -> None:
+        self._inbox.put(("beat", beat))
+
+    def note_off(self, performer: Performer, event: NoteOff) -> None:
+        self._inbox.put(("off", performer, event))
+
+    def sync_clock(self) -> None:
+        """Send the session clock's anchor if it moved (a clock offset correction)."""
+        anchor = self._now_s() - time.monotonic()
+        if self._anchor is None or abs(anchor - self._anchor) > ANCHOR_TOLERANCE_S:
+            self._anchor = anchor
+            self._inbox.put(("clock", anchor))
+
+    # -- life ------------------------------------------------------------------
+    @property
+    def closed(self) -> bool:
+        """The window was closed (Esc, Q, the window manager) or its process ended."""
+        return not self._proc.is_alive()
+
+    @property
+    def sentinel(self) -> int:
+        """A file descriptor that becomes readable when the viewer process ends."""
+        return int(self._proc.sentinel)
+
+    def close(self, timeout_s: float = 10.0) -> ViewerStats:
+        """Stop the frame loop, close the window, collect the frame counts."""
+        if self._proc.is_alive():
+            self._inbox.put(("stop",))
+        deadline = time.monotonic() + timeout_s
+        while self.stats is None and time.monotonic() < deadline:
+            try:
+                msg = self._back.get(timeout=max(0.01, deadline - time.monotonic()))
+            except queue.Empty:
+                break
+            if msg[0] == "stats":
+                self.stats = ViewerStats(**msg[1])
+        self._proc.join(timeout=max(0.1, deadline - time.monotonic()))
+        if self._proc.is_alive():
+            self._kill()
+        self._inbox.close()
+        self._inbox.cancel_join_thread()
+        return self.stats or ViewerStats()
+
+    def _kill(self) -> None:
+        self._proc.terminate()
+        self._proc.join(timeout=5)
+
+
+def viewer_main(spec: ViewerSpec, inbox: Any, back: Any, parent_pid: int, anchor: float) -> None:
+    """The viewer process: open the window, then draw frames until told to stop."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the planning side's to handle
+    try:
+        from virja.live.frames import FrameLoop, Inbox
+        from virja.live.pacing import FramePacer
+        from virja.motion.band import BandAnimator
+        from virja.render.camera import PRESETS
+        from virja.render.live import LiveView
+
+        view = LiveView(spec.size, spec.title, spec.samples, vsync=spec.vsync)
+        view.host.state.camera = PRESETS[spec.camera]
+        animator = BandAnimator()
+    except Exception as exc:  # a clear line for the parent, which raises it
+        back.put(("error", str(exc)))
+        return
+    back.put(("ready",))
+
+    def get() -> tuple[Any, ...] | None:
+        try:
+            item: tuple[Any, ...] = inbox.get_nowait()
+        except queue.Empty:
+            return None
+        return item
+
+    pacer = FramePacer(1.0 / spec.fps)
+    loop = FrameLoop(
+        animator,
+        [view],
+        Inbox(get),
+        pacer,
+        anchor_s=anchor,
+        alive=lambda: os.getppid() == parent_pid,
+    )
+    try:
+        while loop.step():
+            if not pacer.vsync and pacer.shown == 30:
+                refresh = view.refresh_s()
+                if refresh is not None:  # the swaps wait for the display: let them pace
+                    pacer.vsync = True
+                    pacer.period_s = refresh
+    except Exception as exc:
+        print(f"virja viewer: {exc}", file=sys.stderr, flush=True)
+    finally:
+        stats = ViewerStats(view.frames, pacer.skipped, loop.received, pacer.vsync)
+        with contextlib.suppress(Exception):
+            view.close()
+        back.put(("stats", stats.__dict__))

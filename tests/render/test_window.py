@@ -48,24 +48,40 @@ def xvfb_display() -> Iterator[str]:
 WINDOW_SCRIPT = """
 import numpy as np
 from virja.motion.band import BandAnimator
+from virja.input import midi_input
 from virja.plan.planner import OnlinePlanner
 from virja.render.live import LiveView
-from virja.routing import Router
-from virja.session import Performance
+from virja.render.camera import PRESETS
+from virja.routing import Router, RoutingConfig
+from virja.session import Performance, run_schedule
+import virja, pathlib
 
 view = LiveView((320, 200), title="virja test")
-perf = Performance(router=Router(), planner=OnlinePlanner(), animator=BandAnimator())
-for _ in range(3):
-    view.frame(perf, 0.0)
-assert view.host.ctx.error == "GL_NO_ERROR", view.host.ctx.error
+animator = BandAnimator()
+demo = pathlib.Path(virja.__file__).parent / "demo" / "blues.mid"
+src = midi_input(demo, RoutingConfig(), 1.0)
+perf = Performance(router=Router(), planner=OnlinePlanner(), animator=animator)
+run_schedule(perf, src.schedule)
+frames = []
+for i in range(6):  # the window's own framebuffer (GL name 0), frame after frame
+    view.show(animator.pose(6.0 + 0.1 * i))
+    assert view.host.ctx.error == "GL_NO_ERROR", view.host.ctx.error
+    frames.append(view.host.read_window_rgb())
+assert frames[0].shape == (200, 320, 3), frames[0].shape
+assert frames[0].std() > 5, frames[0].std()
+changed = sum(np.abs(a.astype(int) - b).mean() > 0.2 for a, b in zip(frames, frames[1:]))
+assert changed >= 4, changed
+still = animator.pose(6.0)
+view.show(still)
+before = view.host.read_window_rgb()
+view.host.state.camera = PRESETS["top"]
+view.show(still)
+assert np.abs(view.host.read_window_rgb().astype(int) - before).mean() > 5
 shots = []
 view.host.on_screenshot = shots.append
 view.host.state.screenshot_requested = True
-view.frame(perf, 0.0)
-assert len(shots) == 1
-img = shots[0]
-assert img.shape == (200, 320, 3), img.shape
-assert img.std() > 5, img.std()
+view.show(still)
+assert len(shots) == 1 and shots[0].shape == (200, 320, 3)
 assert not view.closed
 view.close()
 print("window ok")

@@ -255,7 +255,8 @@ async def serve(args: argparse.Namespace) -> int:
     from virja.rmcp.pcap import PcapWriter
     from virja.rmcp.receiver import Receiver, ReceiverConfig
     from virja.rmcp.signing import load_key
-    from virja.rmcp.transport import ClockClient, RmcpProtocol, open_listener, parse_hostport
+    from virja.rmcp.stamped import open_stamped_listener
+    from virja.rmcp.transport import ClockClient, RmcpProtocol, parse_hostport
     from virja.session import Performance
 
     load_config(args.config)  # fail early on a bad file
@@ -282,7 +283,7 @@ async def serve(args: argparse.Namespace) -> int:
         raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
     daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
-    transport = await open_listener(host, port, protocol, group=args.group)
+    transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
     viewer = web = None
     sinks = Fanout()  # where committed motions go: the window's process, an animator for --web

@@ -6,8 +6,9 @@ thread writes the pipe) and return.  The viewer process owns the glfw window,
 its GL context, an animator and the frame loop (:mod:`virja.live.frames`).
 Why a process and not a thread: moderngl holds the GIL through every GL call,
 including the waits for llvmpipe, so a drawing thread stalls a receiving
-thread for whole frames (measured: 170-300 ms); in its own process a frame
-only competes for a core, which the kernel hands to the woken receiver at once.
+thread for whole frames (measured: 170-300 ms); in its own process, at a lower
+priority (nice 5), a frame only competes for a core, and the kernel hands the
+core to the woken receiver first.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ log = logging.getLogger(__name__)
 
 READY_TIMEOUT_S = 60.0
 ANCHOR_TOLERANCE_S = 1e-4
+# The viewer's scheduling priority (nice): when the cores are short, a frame is what
+# gives way (it is skipped), never a datagram, the planner, or the sender beside us.
+VIEWER_NICE = 5
 
 
 @dataclass(frozen=True)
@@ -154,6 +158,8 @@ class Viewer:
 def viewer_main(spec: ViewerSpec, inbox: Any, back: Any, parent_pid: int, anchor: float) -> None:
     """The viewer process: open the window, then draw frames until told to stop."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the planning side's to handle
+    with contextlib.suppress(OSError):  # under load, drawing yields the cores first
+        os.nice(VIEWER_NICE)
     try:
         from virja.live.frames import FrameLoop, Inbox
         from virja.live.pacing import FramePacer

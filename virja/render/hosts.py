@@ -231,7 +231,12 @@ class WindowHost:
         """The window's own pixels (its back buffer as last drawn), (h, w, 3), top row first."""
         fb = self.framebuffer()
         w, h = fb.size
-        return np.frombuffer(fb.read(components=3, alignment=1), np.uint8).reshape(h, w, 3)[::-1]
+        data = fb.read(components=3, alignment=1)
+        # moderngl selects GL_COLOR_ATTACHMENT0 to read from, which framebuffer 0 does
+        # not have: GL_INVALID_OPERATION, and the read buffer stays GL_BACK (the one
+        # wanted).  Take that error off the queue so it is not blamed on the next frame.
+        _ = self.ctx.error
+        return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1]
 
     def present(self, fps: float | None = None) -> None:
         if self.state.screenshot_requested and self.on_screenshot is not None:

@@ -178,7 +178,11 @@ class RmcpProtocol(asyncio.DatagramProtocol):
         self.transport = cast(asyncio.DatagramTransport, transport)
 
     def datagram_received(self, data: bytes, addr: Any) -> None:
-        now_us = self.clock.now_us()
+        self.receive(data, addr, now_us=self.clock.now_us())
+
+    def receive(self, data: bytes, addr: Any, *, now_us: int) -> None:
+        """One datagram that arrived at ``now_us`` (session clock; the kernel's
+        stamp of its arrival where :mod:`virja.rmcp.stamped` has one)."""
         if self.recorder is not None:
             self.recorder.write(data, addr, time_us=now_us)
         self.receiver.receive_datagram(data, addr, now_us=now_us)

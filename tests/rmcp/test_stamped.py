@@ -1,0 +1,58 @@
+"""Kernel arrival stamps: a datagram read late (the process was busy) keeps the time
+it arrived, so its note is not judged late."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import sys
+import time
+
+import pytest
+
+from virja.clock import SessionClock
+from virja.rmcp import wire
+from virja.rmcp.receiver import Received, Receiver, ReceiverConfig
+from virja.rmcp.stamped import arrival_us, open_stamped_listener
+from virja.rmcp.transport import RmcpProtocol
+
+
+def test_arrival_is_now_less_the_age_of_the_stamp_and_bounded() -> None:
+    clock = SessionClock(wall_ns=lambda: 1_000_000_000_000, monotonic_ns=lambda: 0)
+    now_us = clock.now_us()
+    assert arrival_us(clock, None, 5) == now_us
+    assert arrival_us(clock, 2_000_000_000, 2_300_000_000) == now_us - 300_000
+    assert arrival_us(clock, 2_000_000_000, 1_000_000_000) == now_us  # a stamp from the future
+    assert arrival_us(clock, 0, 10**12) == now_us - 10_000_000  # at most 10 s back
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="SO_TIMESTAMPNS is Linux's")
+def test_a_datagram_read_late_keeps_its_arrival_time() -> None:
+    got: list[tuple[list[Received], float]] = []
+
+    async def main() -> float:
+        clock = SessionClock()
+        receiver = Receiver(ReceiverConfig(lateness_s=0.06))
+        protocol = RmcpProtocol(receiver, clock, lambda ev, now: got.append((ev, now)))
+        listener = await open_stamped_listener("127.0.0.1", 0, protocol, clock)
+        assert listener.stamped
+        port = listener.get_extra_info("sockname")[1]
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
+            sent_s = clock.now_s()
+            # a note due 30 ms from now: in time when it arrives
+            data = wire.midi(3, 1, clock.now_us() + 30_000, bytes([0x99, 38, 100]))
+            tx.sendto(bytes(data), ("127.0.0.1", port))
+            time.sleep(0.3)  # the loop is busy (a long plan, a starved process)
+            for _ in range(50):
+                await asyncio.sleep(0.01)
+                if got:
+                    break
+        listener.close()
+        assert receiver.stats.dropped["too_late"] == 0
+        return sent_s
+
+    sent_s = asyncio.run(main())
+    assert len(got) == 1
+    events, now_s = got[0]
+    assert len(events) == 1 and not events[0].late
+    assert 0 <= now_s - sent_s < 0.2  # when it arrived, not when it was read (0.3 s on)

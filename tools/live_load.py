@@ -69,7 +69,9 @@ def one_run(display: str, size: str, headless: bool = False) -> str:
             h.terminate()
             h.join()
         keep = ("notes:", "events dropped", "window:")
-        return " | ".join(line.strip() for line in out.splitlines() if line.strip().startswith(keep))
+        return " | ".join(
+            line.strip() for line in out.splitlines() if line.strip().startswith(keep)
+        )
 
 
 def main() -> int:

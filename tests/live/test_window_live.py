@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from tests.live.xdisplay import XDisplay, env_for, start_xvfb
 import virja
+from tests.live.xdisplay import XDisplay, env_for, start_xvfb
 
 VIRJA = [sys.executable, "-m", "virja"]
 W, H = 320, 240
@@ -153,3 +153,44 @@ def test_windowed_serve_under_load_plans_every_note_of_the_demo(
     assert "0 dropped by the scheduler" in out, out
     changes = sum(_diff(a, b) > 0.5 for a, b in zip(shots, shots[1:], strict=False))
     assert len(shots) >= 20 and changes >= len(shots) // 2, (len(shots), changes)
+
+
+def test_replay_in_a_window_shows_the_band_moving(display: str, tmp_path: Path) -> None:
+    from virja.rmcp import wire
+    from virja.rmcp.pcap import PcapWriter
+
+    pcap = tmp_path / "s.pcap"
+    t0_us = 1_700_000_000_000_000
+    writer = PcapWriter.open(pcap, local=("127.0.0.1", 50500))
+    for i in range(24):  # six seconds of snare and bass, each sent half a second ahead
+        note_us = t0_us + 1_000_000 + i * 250_000
+        msgs = [bytes([0x99, 38, 100])] if i % 2 else [bytes([0xC1, 32]), bytes([0x91, 40, 90])]
+        writer.write(
+            bytes(wire.midi(5, i, note_us, *msgs)), ("127.0.0.1", 40000), time_us=note_us - 500_000
+        )
+    writer.close()
+    proc = subprocess.Popen(
+        [*VIRJA, "replay", str(pcap), "--size", f"{W}x{H}"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env_for(display),
+    )
+    x = XDisplay(display)
+    shots: list[NDArray[np.uint8]] = []
+    try:
+        while proc.poll() is None and len(shots) < 200:
+            shot = x.screenshot(W, H)
+            if shot.std() > 5:
+                shots.append(shot)
+            time.sleep(0.25)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        x.close()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0, err
+    assert "24 notes planned" in out, out
+    changes = sum(_diff(a, b) > 0.1 for a, b in zip(shots, shots[1:], strict=False))
+    assert len(shots) >= 10 and changes >= len(shots) // 2, (len(shots), changes)

@@ -9,7 +9,6 @@ import ctypes.util
 import os
 import shutil
 import subprocess
-import time
 from collections.abc import Iterator
 
 import numpy as np

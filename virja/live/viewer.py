@@ -81,6 +81,7 @@ class Viewer:
         self.spec = spec
         self._now_s = now_s
         self._anchor: float | None = None
+        self._shut = False
         self._inbox: Any = ctx.Queue()
         self._back: Any = ctx.Queue()
         self.sync_clock()
@@ -105,20 +106,24 @@ class Viewer:
 
     # -- the plan sink ---------------------------------------------------------
     def add_planned(self, p: PlannedNote) -> None:
-        self._inbox.put(("planned", p))
+        self._put(("planned", p))
 
     def add_beat(self, beat: Beat) -> None:
-        self._inbox.put(("beat", beat))
+        self._put(("beat", beat))
 
     def note_off(self, performer: Performer, event: NoteOff) -> None:
-        self._inbox.put(("off", performer, event))
+        self._put(("off", performer, event))
+
+    def _put(self, item: tuple[Any, ...]) -> None:
+        if not self._shut:  # after close (a replay's last notes) nothing is drawn
+            self._inbox.put(item)
 
     def sync_clock(self) -> None:
         """Send the session clock's anchor if it moved (a clock offset correction)."""
         anchor = self._now_s() - time.monotonic()
         if self._anchor is None or abs(anchor - self._anchor) > ANCHOR_TOLERANCE_S:
             self._anchor = anchor
-            self._inbox.put(("clock", anchor))
+            self._put(("clock", anchor))
 
     # -- life ------------------------------------------------------------------
     @property
@@ -133,8 +138,11 @@ class Viewer:
 
     def close(self, timeout_s: float = 10.0) -> ViewerStats:
         """Stop the frame loop, close the window, collect the frame counts."""
+        if self._shut:
+            return self.stats or ViewerStats()
         if self._proc.is_alive():
             self._inbox.put(("stop",))
+        self._shut = True
         deadline = time.monotonic() + timeout_s
         while self.stats is None and time.monotonic() < deadline:
             try:

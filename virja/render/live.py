@@ -66,7 +66,9 @@ class LiveView:
         swaps = sorted(self._swap_s)
         median = swaps[len(swaps) // 2]
         rate = self.host.refresh_rate()
-        period = 1.0 / rate if rate else 1.0 / 60.0
+        if rate is None:  # no refresh rate (Xvfb): no display to wait for
+            return None
+        period = 1.0 / rate
         return period if median >= VSYNC_SWAP_FRACTION * period else None
 
     def show(self, pose: BandPose, extra: Sequence[DrawList] = ()) -> None:

@@ -262,6 +262,8 @@ def run(args: argparse.Namespace) -> int:
         f"{counts['drums']} drum events, {perf.counts['planned']} motions planned, "
         f"{midi_in.reconnects} reconnects"
     )
+    if view is not None and view.stats is not None:
+        print(f"virja jam: window: {view.stats.frames} frames shown, {view.stats.skipped} skipped")
     return 0
 
 

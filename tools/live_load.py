@@ -68,7 +68,7 @@ def one_run(display: str, size: str, headless: bool = False) -> str:
         for h in hogs:
             h.terminate()
             h.join()
-        keep = ("notes:", "events dropped", "dropped:", "window:")
+        keep = ("notes:", "dropped on arrival", "dropped:", "window:")
         return " | ".join(
             line.strip() for line in out.splitlines() if line.strip().startswith(keep)
         )

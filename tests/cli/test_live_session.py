@@ -100,7 +100,7 @@ def test_send_serve_record_replay_give_one_plan(tmp_path: Path) -> None:
         if serve.poll() is None:
             serve.kill()
     assert serve.returncode == 0, err
-    assert "0 rejected" in out and "events dropped on arrival: 0" in out, out
+    assert "0 rejected" in out and "dropped on arrival, never planned: 0" in out, out
     assert "0 dropped by the scheduler" in out, out
     live = [json.loads(line) for line in plan_live.read_text().splitlines()]
     assert all(tuple(obj) == JSON_KEYS for obj in live)

@@ -176,7 +176,7 @@ class Daemon:
             f"{c['planned']} planned ({self.late_notes} arrived late and were played "
             f"compressed), {plan.get('dropped', 0)} dropped by the scheduler"
             + _reasons(by_planner),
-            f"events dropped on arrival: {sum(on_arrival.values())}"
+            f"dropped on arrival, never planned: {sum(on_arrival.values())}"
             + _reasons(on_arrival, explain=True),
             f"notes not the band's: {c['notes_not_the_bands']}",
         ]

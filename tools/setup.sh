@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 APT_PACKAGES=(
   libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri  # OpenGL through EGL (Mesa llvmpipe without a GPU)
   xvfb xauth                                   # a real window in tests and on servers
+  libx11-6 libxtst6                            # the window tests read the X screen and type keys (XTest)
   fluidsynth fluid-soundfont-gm                # MIDI -> audio for videos with sound
   jackd2                                       # live MIDI ports (jam) through JACK
   chromium                                     # the browser viewer's tests (Playwright drives it)

@@ -194,3 +194,17 @@ def test_replay_in_a_window_shows_the_band_moving(display: str, tmp_path: Path) 
     assert "24 notes planned" in out, out
     changes = sum(_diff(a, b) > 0.1 for a, b in zip(shots, shots[1:], strict=False))
     assert len(shots) >= 10 and changes >= len(shots) // 2, (len(shots), changes)
+
+
+def test_serve_without_a_display_says_so_in_one_line() -> None:
+    env = {k: v for k, v in env_for(":0").items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    res = subprocess.run(
+        [*VIRJA, "serve", "--listen", "127.0.0.1:0", "--duration", "5"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
+    assert res.returncode != 0
+    assert "Traceback" not in res.stderr
+    assert "--headless" in res.stderr and len(res.stderr.strip().splitlines()) == 1, res.stderr

@@ -63,9 +63,10 @@ def test_twenty_viewers_and_the_demo_plays_into_serve_without_a_lost_note(tmp_pa
         served.proc.send_signal(signal.SIGINT)
         out, err = served.proc.communicate(timeout=30)
     assert served.proc.returncode == 0, err
-    assert "dropped: none" in out, out
+    assert "0 rejected" in out and "dropped on arrival, never planned: 0" in out, out
     # all 59 band notes of the excerpt (14 bass, 45 drums: `virja plan` of it), none late
-    assert re.search(r"notes: 59 planned, 0 arrived late", out), out
+    assert re.search(r"notes: 59 for the band .*, 59 planned \(0 arrived late", out), out
+    assert "0 dropped by the scheduler" in out, out
     m = re.search(r"web: (\d+) viewers, (\d+) frames", out)
     assert m and int(m.group(1)) == READERS + STALLED + VANISHING, out
     for got in times:

@@ -201,6 +201,23 @@ def test_skip_existing_skips_done_inputs_and_retries_failed_ones(
     assert rows["corrupt.mid"]["status"] == "error"
 
 
+def _workers_of(token: str) -> list[int]:
+    """Live processes carrying the environment marker ``token`` (an orphaned pool
+    worker's parent becomes 1, so they are found by what they inherited)."""
+    found = []
+    for proc_dir in Path("/proc").iterdir():
+        if not proc_dir.name.isdigit():
+            continue
+        try:
+            env = (proc_dir / "environ").read_bytes()
+            state = (proc_dir / "stat").read_text().split()[2]
+        except OSError:
+            continue
+        if f"VIRJA_BATCH_TEST={token}".encode() in env and state != "Z":
+            found.append(int(proc_dir.name))
+    return found
+
+
 def test_a_killed_batch_resumes_where_it_stopped(corpus: Path, tmp_path: Path) -> None:
     """SIGKILL halfway, then --skip-existing: nothing half-written is taken as done."""
     shutil.rmtree(corpus / "broken")
@@ -209,7 +226,9 @@ def test_a_killed_batch_resumes_where_it_stopped(corpus: Path, tmp_path: Path) -
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "virja", "batch", str(corpus), "--out", str(out)]
     cmd += ["--export", "plan,bvh", "--workers", "1"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    token = f"{os.getpid()}-{time.monotonic_ns()}"
+    marker = os.environ | {"VIRJA_BATCH_TEST": token}
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=marker)
     manifest = out / "manifest.jsonl"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
@@ -218,6 +237,11 @@ def test_a_killed_batch_resumes_where_it_stopped(corpus: Path, tmp_path: Path) -
         time.sleep(0.05)
     proc.send_signal(signal.SIGKILL)
     proc.wait(timeout=10)
+    # its workers die with it (PR_SET_PDEATHSIG): none is left behind, stuck on a pipe
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and _workers_of(token):
+        time.sleep(0.05)
+    assert not _workers_of(token)
     first = read_manifest(manifest)
     assert 2 <= len(first) < 8, "the kill should land halfway"
     # what a kill in the middle of writing leaves behind: a temporary file, never a final name

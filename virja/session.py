@@ -76,6 +76,9 @@ class Performance:
             return None
         if isinstance(event, Chord):
             self.hud.add(event)
+            add_chord = getattr(self.animator, "add_chord", None)
+            if add_chord is not None:  # the live window's heads-up display
+                add_chord(event)
             return None
         performer = self.router.route(event)
         if performer is not None:

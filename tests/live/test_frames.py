@@ -74,7 +74,10 @@ def _loop(items: list[tuple[Any, ...]], clock: Clock, sink: Sink, **kw: Any) -> 
 def test_each_frame_shows_the_pose_of_its_slot_in_session_time() -> None:
     clock = Clock()
     sink = Sink(clock, close_after=5)
-    items: list[tuple[Any, ...]] = [("clock", 1000.0), ("planned", "n1"), ("beat", "b1")]
+    from virja.events import Beat
+
+    b1 = Beat(1100.0, 0, 1, 4, 2, 500_000)
+    items: list[tuple[Any, ...]] = [("clock", 1000.0), ("planned", "n1"), ("beat", b1)]
     animator = Animator()
     loop = _loop(items, clock, sink, animator=animator)
     loop.run()
@@ -83,7 +86,7 @@ def test_each_frame_shows_the_pose_of_its_slot_in_session_time() -> None:
     # session time = anchor + the monotonic moment the frame is shown: a slot apart
     assert all(abs((b - a) - 0.02) < 1e-9 for a, b in zip(times, times[1:], strict=False))
     assert 1100.0 <= times[0] < 1100.1
-    assert animator.planned == ["n1"] and animator.beats == ["b1"]
+    assert animator.planned == ["n1"] and animator.beats == [b1]
     assert animator.posed[0][1] == 1  # what arrived was drained before the frame was posed
     assert loop.received == 1
 
@@ -112,3 +115,31 @@ def test_a_slow_frame_skips_slots_and_does_not_fall_behind() -> None:
     for (t, _), shown_at in zip(animator.posed[3:], animator.posed[4:], strict=False):
         assert shown_at[0] - t <= 0.05 + 0.02 + 1e-9
     assert animator.posed[-1][0] >= clock.t - 0.05 - 1e-9
+
+
+class HudSink(Sink):
+    def __init__(self, clock: Clock, close_after: int = 10**9) -> None:
+        super().__init__(clock, close_after)
+        self.texts: list[str] = []
+
+    def set_hud(self, text: str) -> None:
+        self.texts.append(text)
+
+
+def test_the_heads_up_display_reads_the_moment_each_frame_shows() -> None:
+    """Beats and chords sent ahead reach the window's heads-up display at their time."""
+    from virja.events import Beat, Chord
+
+    clock = Clock()
+    sink = HudSink(clock, close_after=30)
+    items: list[tuple[Any, ...]] = [
+        ("beat", Beat(100.1, 4, 1, 4, 2, 500_000)),
+        ("chord", Chord(100.1, 10, None, "7")),
+        ("beat", Beat(100.3, 4, 2, 4, 0, 500_000)),
+    ]
+    loop = _loop(items, clock, sink)
+    loop.run()
+    assert sink.texts[0] == ""  # before the first beat: nothing known yet
+    assert "120 bpm   bar 5.1   Bb7" in sink.texts
+    assert sink.texts[-1] == "120 bpm   bar 5.2   Bb7"
+    assert len(sink.texts) == len(sink.shown)

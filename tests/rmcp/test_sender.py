@@ -226,3 +226,19 @@ def test_a_restarted_sender_is_not_taken_for_repeats_or_replays() -> None:
             assert rx.stats.dropped.get("duplicate", 0) == 0, (run, key)
             assert not rx.stats.dropped, (run, key, rx.stats.dropped)
         assert rx.stats.accepted == sum(len(r) for r in runs)
+
+
+def test_chords_go_out_as_chord_messages_from_the_conductor() -> None:
+    """A file's chord symbols reach a receiver's heads-up display, a beat ahead like notes."""
+    from virja.events import Chord
+    from virja.rmcp.bodies import ChordBody
+
+    options = SendOptions()
+    items, _ = schedule_pass(
+        [Chord(2.0, 10, None, "7")], TempoMap(), [], options, 1_000_000, route=lambda ev: None
+    )
+    (item,) = items
+    assert isinstance(item.datagram.body, ChordBody)
+    assert (item.datagram.body.root, item.datagram.body.quality) == (10, "7")
+    assert item.datagram.sender == options.conductor
+    assert item.datagram.time_us == 3_000_000 and item.send_us < item.datagram.time_us

@@ -83,6 +83,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--headless", action="store_true", help="no window: plan (and log) only")
     parser.add_argument(
+        "--size", default="1280x720", metavar="WxH", help="window size (default 1280x720)"
+    )
+    parser.add_argument(
+        "--hud",
+        action="store_true",
+        help="show the heads-up display (tempo, bar.beat, chord) from the start; key H toggles it",
+    )
+    parser.add_argument(
         "--plan-log", default=None, metavar="FILE.jsonl", help="write planned notes"
     )
     parser.add_argument(
@@ -197,10 +205,12 @@ def run(args: argparse.Namespace) -> int:
     from virja.jam.keyboard import routing_table
     from virja.jam.live import KeyboardJam, RmcpStream
     from virja.jam.ports import MidiInput, MidiOutput, probe_api
+    from virja.render.offline import parse_size
     from virja.rmcp.transport import parse_hostport
 
     if args.duration is not None and args.duration <= 0:
         raise ConfigError("--duration must be > 0")
+    size = parse_size(args.size)  # checked before any port opens
     doc = load_config(args.config)
     opts = _options(args, doc)
     if args.list_ports:
@@ -222,7 +232,8 @@ def run(args: argparse.Namespace) -> int:
             from virja.live.sinks import Fanout
             from virja.live.viewer import Viewer, ViewerSpec
 
-            view = Viewer(ViewerSpec(title="virja jam", fps=opts.fps), clock.now_s)
+            spec = ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
+            view = Viewer(spec, clock.now_s)
             perf.animator = Fanout([s for s in (perf.animator, view) if s is not None])
             stack.callback(view.close)
         web = open_web(args, perf, clock.now_s)

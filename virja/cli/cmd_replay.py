@@ -46,6 +46,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--headless", action="store_true", help="draw nothing: plan and summary only")
     p.add_argument(
+        "--hud",
+        action="store_true",
+        help="heads-up display (tempo, bar.beat, chord): in the window (key H toggles it) "
+        "and in --out renders",
+    )
+    p.add_argument(
         "--out", metavar="OUT", help="render to a video (.mp4/.mkv/.mov), a folder or NAME.png"
     )
     p.add_argument("--size", default="1280x720", metavar="WxH")
@@ -156,6 +162,7 @@ def play_live(perf: Any, src: Any, args: argparse.Namespace) -> None:
                 f"virja replay {Path(args.input).name}",
                 samples=args.samples,
                 camera=args.camera,
+                hud=args.hud,
             )
             viewer = Viewer(spec, now_s)
             sinks.add(viewer)

@@ -89,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
         stats = asyncio.run(
             stream(
                 to=(host, port),
-                events=session.events,
+                # chord symbols the file carries go out as CHORD messages
+                events=sorted([*session.events, *session.chords], key=lambda e: e.time_s),
                 tempo=session.tempo_map,
                 beats=session.beats,
                 duration_s=session.duration_s,

@@ -56,6 +56,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--headless", action="store_true", help="no window; everything else the same")
     p.add_argument(
+        "--hud",
+        action="store_true",
+        help="show the heads-up display (tempo, bar.beat, chord) from the start; key H toggles it",
+    )
+    p.add_argument(
         "--record",
         metavar="FILE.pcap",
         help="record every datagram that arrives (valid or not) as pcap",
@@ -295,7 +300,9 @@ async def serve(args: argparse.Namespace) -> int:
             sinks.add(BandAnimator())
         if not args.headless:
             viewer = Viewer(
-                ViewerSpec(parse_size(args.size), f"virja serve {host}:{port}", args.fps),
+                ViewerSpec(
+                    parse_size(args.size), f"virja serve {host}:{port}", args.fps, hud=args.hud
+                ),
                 clock.now_s,
             )
             sinks.add(viewer)

@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from virja.hud import HudTimeline
 from virja.live.pacing import FramePacer
 from virja.motion.pose import BandPose
 
@@ -77,6 +78,7 @@ class FrameLoop:
         self.alive = alive
         self.stopped = False
         self.received = 0
+        self.hud = HudTimeline()  # beats and chords: the heads-up display's line
 
     def drain(self) -> None:
         """Everything the planning side sent so far, into the animator."""
@@ -87,6 +89,9 @@ class FrameLoop:
                 self.received += 1
             elif kind == "beat":
                 self.animator.add_beat(item[1])
+                self.hud.add(item[1])
+            elif kind == "chord":
+                self.hud.add(item[1])
             elif kind == "off":
                 off = getattr(self.animator, "note_off", None)
                 if off is not None:
@@ -111,7 +116,11 @@ class FrameLoop:
             return False
         started = self.monotonic()
         pose = self.animator.pose(self.anchor_s + slot.show_at)
+        hud_text = self.hud.at(self.anchor_s + slot.show_at).text()
         for s in self.sinks:
+            set_hud = getattr(s, "set_hud", None)
+            if set_hud is not None:
+                set_hud(hud_text)
             s.show(pose)
         self.pacer.drawn(started, self.monotonic())
         if self.pacer.shown % FORGET_EVERY == 0:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from virja.events import Beat, NoteOff, Performer
+from virja.events import Beat, Chord, NoteOff, Performer
 from virja.motion.pose import BandPose
 from virja.plan.types import PlannedNote
 from virja.session import PlanSink
@@ -32,6 +32,13 @@ class Fanout:
     def add_beat(self, beat: Beat) -> None:
         for s in self.sinks:
             s.add_beat(beat)
+
+    def add_chord(self, chord: Chord) -> None:
+        """Chords for the heads-up display of the sinks that show one."""
+        for s in self.sinks:
+            add = getattr(s, "add_chord", None)
+            if add is not None:
+                add(chord)
 
     def pose(self, time_s: float) -> BandPose:
         """The pose of the first sink that animates here (a BandAnimator beside the

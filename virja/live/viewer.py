@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from virja.errors import NotAvailableError
-from virja.events import Beat, NoteOff, Performer
+from virja.events import Beat, Chord, NoteOff, Performer
 from virja.plan.types import PlannedNote
 
 log = logging.getLogger(__name__)
@@ -48,6 +48,7 @@ class ViewerSpec:
     samples: int = 1
     camera: str = "front"
     vsync: bool = True
+    hud: bool = False  # heads-up display shown from the start (key H toggles it)
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,9 @@ class Viewer:
 
     def add_beat(self, beat: Beat) -> None:
         self._put(("beat", beat))
+
+    def add_chord(self, chord: Chord) -> None:
+        self._put(("chord", chord))
 
     def note_off(self, performer: Performer, event: NoteOff) -> None:
         self._put(("off", performer, event))
@@ -175,7 +179,7 @@ def viewer_main(spec: ViewerSpec, inbox: Any, back: Any, parent_pid: int, anchor
         from virja.render.camera import PRESETS
         from virja.render.live import LiveView
 
-        view = LiveView(spec.size, spec.title, spec.samples, vsync=spec.vsync)
+        view = LiveView(spec.size, spec.title, spec.samples, vsync=spec.vsync, hud=spec.hud)
         view.host.state.camera = PRESETS[spec.camera]
         animator = BandAnimator()
     except Exception as exc:  # a clear line for the parent, which raises it

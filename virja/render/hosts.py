@@ -108,13 +108,14 @@ class WindowState:
     last_cursor: tuple[float, float] = (0.0, 0.0)
     screenshot_requested: bool = False
     fullscreen: bool = False
+    hud: bool = False  # the heads-up display (tempo, bar.beat, chord), key H
     windowed_rect: tuple[int, int, int, int] = (100, 100, 1280, 720)
 
 
 class WindowHost:
     """A resizable glfw window: drag to orbit, scroll to zoom, keys for the rest.
 
-    Keys: 1-4 camera presets (front, drums, bass, top), F fullscreen, S
+    Keys: 1-4 camera presets (front, drums, bass, top), H heads-up display, F fullscreen, S
     screenshot (PNG in the working folder), Esc or Q close.
     """
 
@@ -170,6 +171,8 @@ class WindowHost:
             self.state.camera = PRESETS[presets[key]]
         elif key == g.KEY_S:
             self.state.screenshot_requested = True
+        elif key == g.KEY_H:
+            self.state.hud = not self.state.hud
         elif key == g.KEY_F:
             self.toggle_fullscreen()
 

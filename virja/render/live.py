@@ -17,6 +17,7 @@ import numpy as np
 
 from virja.motion.pose import BandPose
 from virja.render.hosts import OffscreenTarget, WindowHost
+from virja.render.hud import HudOverlay
 from virja.render.images import write_png
 from virja.render.renderer import DrawList, Renderer
 from virja.render.scene import band_scene, static_scene
@@ -36,8 +37,12 @@ class LiveView:
         samples: int = 1,
         *,
         vsync: bool = True,
+        hud: bool = False,
     ) -> None:
         self.host = WindowHost(size, title, vsync=vsync)
+        self.host.state.hud = hud
+        self.hud_text = ""  # set before each frame by the frame loop (set_hud)
+        self._overlay: HudOverlay | None = None
         self.samples = samples
         self.target: OffscreenTarget | None = None
         self.renderer = Renderer(self.host.ctx)
@@ -58,6 +63,10 @@ class LiveView:
     @property
     def closed(self) -> bool:
         return self.host.should_close
+
+    def set_hud(self, text: str) -> None:
+        """The heads-up display's line for the next frame (shown while H is on)."""
+        self.hud_text = text
 
     def refresh_s(self) -> float | None:
         """The display's refresh period if swaps wait for it (vsync), else None."""
@@ -80,6 +89,10 @@ class LiveView:
             self.target = OffscreenTarget(self.host.ctx, fb.size, samples=self.samples)
         layers = [self.static, band_scene(pose), *extra]
         self.renderer.draw(layers, self.host.state.camera, self.target.fbo)
+        if self.host.state.hud and self.hud_text:
+            if self._overlay is None:
+                self._overlay = HudOverlay(self.host.ctx)
+            self._overlay.draw(self.target.fbo, self.hud_text)
         self.host.ctx.copy_framebuffer(fb, self.target.fbo)
         self.host.ctx.finish()  # the drawing is done: what the swap waits for is the display
         self._fps_frames += 1

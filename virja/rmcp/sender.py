@@ -15,8 +15,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramChange
-from virja.rmcp.bodies import BeatBody, MidiBody
+from virja.events import Beat, Chord, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.rmcp.bodies import BeatBody, ChordBody, MidiBody
 from virja.rmcp.seqnum import seq_add
 from virja.rmcp.wire import MAX_BODY, Datagram, event_message, s_to_us
 from virja.tempo import Tempo, TempoMap
@@ -97,7 +97,11 @@ def schedule_pass(
         if r is not None and isinstance(ev, NoteOn | NoteOff):
             channel_route.setdefault((ev.track, ev.channel), r)
     programs: list[tuple[float, int, int, int]] = []  # (time, sender, channel, program)
+    chords: list[Chord] = []  # sent by the conductor, like beats (for heads-up displays)
     for ev, r in zip(events, routes, strict=True):
+        if isinstance(ev, Chord):
+            chords.append(ev)
+            continue
         msg = event_message(ev)
         if msg is None:
             continue
@@ -110,7 +114,9 @@ def schedule_pass(
             groups[key] = []
             order.append((ev.time_s, key))
         groups[key].append(msg)
-    items: list[tuple[int, int, int, int, MidiBody | BeatBody]] = []  # send, time, n, sender
+    items: list[
+        tuple[int, int, int, int, MidiBody | BeatBody | ChordBody]
+    ] = []  # send, time, n, sender
     n = 0
     for time_s, key in order:
         lead_us = s_to_us(options.lead_beats * tempo.seconds_per_beat_at(time_s))
@@ -132,6 +138,13 @@ def schedule_pass(
                 repeat = MidiBody((bytes((0xC0 | channel, program)),))
                 items.append((time_us - lead_us, time_us, n, sender, repeat))
                 n += 1
+    for c in chords:
+        time_us = start_us + s_to_us(c.time_s)
+        lead_us = s_to_us(options.lead_beats * tempo.seconds_per_beat_at(c.time_s))
+        items.append(
+            (time_us - lead_us, time_us, n, options.conductor, ChordBody(c.root, c.bass, c.quality))
+        )
+        n += 1
     items.sort(key=lambda it: (it[0], it[1], it[2]))
     out: list[Scheduled] = []
     for send_us, time_us, _, sender, body in items:

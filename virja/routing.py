@@ -20,7 +20,7 @@ Channels in the config are 1-based, as musicians count them; events carry
 from __future__ import annotations
 
 import re
-from collections import Counter
+from collections import Counter, OrderedDict
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -32,6 +32,8 @@ GM_BASS_PROGRAMS = frozenset(range(32, 40))  # Acoustic Bass .. Synth Bass 2 (0-
 DEFAULT_BASS_WORDS = ("bass", "contrabass", "kontrabass", "basse", "bajo", "baixo", "upright")
 # words that mean the track is not a bass part even though it contains "bass"
 DEFAULT_NOT_BASS_WORDS = ("drum", "bassdrum", "bass drum", "kick")
+# (source, channel) programs remembered: 1,024 senders (the receiver's cap) x 16 channels
+MAX_PROGRAMS = 16_384
 
 Route = Performer | None
 _TARGETS: dict[str, Route] = {"bass": "bass", "drums": "drums", "none": None}
@@ -140,15 +142,20 @@ class Router:
 
     The source is the track index for files and the sender id for network
     input.  Events must be fed in time order (program changes take effect for
-    the notes after them).
+    the notes after them).  At most ``max_programs`` (source, channel) programs
+    are remembered, the least recently changed forgotten first: 65,536 network
+    senders cannot grow it without bound (docs/reliability.md).
     """
+
+    max_programs = MAX_PROGRAMS
 
     def __init__(
         self, config: RoutingConfig | None = None, track_names: Mapping[int, str] | None = None
     ) -> None:
         self.config = config or RoutingConfig()
         self.track_names = dict(track_names or {})
-        self._programs: dict[tuple[int | None, int], int] = {}
+        self._programs: OrderedDict[tuple[int | None, int], int] = OrderedDict()
+        self.programs_evicted = 0
         self.counts: Counter[tuple[int | None, int, str]] = Counter()
 
     @classmethod
@@ -163,7 +170,12 @@ class Router:
     def route(self, event: Event) -> Route:
         """The performer of a note event; None for anything not the band's."""
         if isinstance(event, ProgramChange):
-            self._programs[(self._source(event), event.channel)] = event.program
+            key = (self._source(event), event.channel)
+            self._programs[key] = event.program
+            self._programs.move_to_end(key)
+            if len(self._programs) > self.max_programs:
+                self._programs.popitem(last=False)
+                self.programs_evicted += 1
             return None
         if not isinstance(event, NoteOn | NoteOff):
             return None

@@ -23,6 +23,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
+from virja.plan.bounds import keep_best
 from virja.plan.config import DrumCosts, Timing
 
 Hand = str  # "left_hand" | "right_hand"
@@ -240,7 +241,12 @@ _Move = tuple[int, float, int, float, int]
 
 
 def solve(
-    costs: DrumCosts, timing: Timing, state: HandState, groups: Sequence[HandGroup]
+    costs: DrumCosts,
+    timing: Timing,
+    state: HandState,
+    groups: Sequence[HandGroup],
+    *,
+    beam: int | None = None,
 ) -> HandSolution:
     """Least-objective assignment of every group from ``state`` (DP over hand states).
 
@@ -275,6 +281,9 @@ def solve(
 
     tests/plan/test_solver_equivalence.py keeps the plain DP and checks that every
     result (assignments, per-stroke costs, states, total) is equal on random input.
+
+    ``beam`` (virja.plan.bounds): a layer of more states keeps only the ``beam`` of
+    least objective, in their order; no effect on a layer that is not larger.
     """
     max_interval = timing.max_gap
     gap = timing.gap
@@ -378,6 +387,13 @@ def solve(
                 nacc[nid] = total
                 back_s[nid] = sid
                 back_k[nid] = drop_k
+        if beam is not None:
+            kept = keep_best(cast(list[float], nacc), beam)
+            if kept is not None:  # cut: the least-cost states, renumbered in order
+                nxt = [nxt[i] for i in kept]
+                nacc = [nacc[i] for i in kept]
+                back_s = [back_s[i] for i in kept]
+                back_k = [back_k[i] for i in kept]
         layer, accs = nxt, cast(list[float], nacc)
         layers.append(nxt)
         backs.append((back_s, back_k))

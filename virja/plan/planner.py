@@ -24,6 +24,7 @@ from typing import Any
 from virja.events import Beat, NoteOn, Performer
 from virja.plan import bass as bass_mod
 from virja.plan import drums as drums_mod
+from virja.plan.bounds import DEFAULT_BOUNDS, DensityGate, PlanBounds
 from virja.plan.config import DrumNote, PlanConfig, default_config
 from virja.plan.timing import align
 from virja.plan.types import DroppedNote, DropReason, Limb, MovedNote, PlannedNote, PlanReport
@@ -145,13 +146,21 @@ class OnlinePlanner:
     :meth:`add_beat` take precedence from their time on.
     """
 
-    def __init__(self, config: PlanConfig | None = None, *, tempo: Tempo | None = None) -> None:
+    def __init__(
+        self,
+        config: PlanConfig | None = None,
+        *,
+        tempo: Tempo | None = None,
+        bounds: PlanBounds = DEFAULT_BOUNDS,
+    ) -> None:
         self.config = _config(config)
+        self.bounds = bounds
         self._tempo = tempo
         self._beat_times: list[float] = []  # sorted; at most MAX_BEATS_KEPT, the latest
         self._beat_spb: list[float] = []
         self._chains = {n: _Chain(n) for n in ("bass", "hands", "right_foot", "left_foot")}
         self._chains["hands"].state = drums_mod.START
+        self._gates = {n: DensityGate(bounds) for n in self._chains}
         self._outbox: list[PlannedNote] = []
         self._dropped: deque[DroppedNote] = deque(maxlen=MAX_REPORTED)
         self._moved: deque[MovedNote] = deque(maxlen=MAX_REPORTED)
@@ -184,6 +193,12 @@ class OnlinePlanner:
         if rec is None:
             return
         chain = self._chains[rec.chain]
+        if len(chain.pending) >= self.bounds.max_pending:
+            self._drop(rec, "planner_full")
+            return
+        if not self._gates[rec.chain].admit(note.time_s):
+            self._drop(rec, "too_dense")
+            return
         if chain.last_fixed_t is not None and note.time_s <= chain.last_fixed_t + GROUP_EPS_S:
             self._place_out_of_order(chain, rec)
         else:
@@ -300,12 +315,11 @@ class OnlinePlanner:
             self._fix_hands(chain, groups, n_groups)
         else:
             self._fix_foot(chain, groups, n_groups)
-        if chain.plan is not None:
-            chain.plan = chain.plan[n_groups:]
         fixed = {r.seq for g in groups[:n_groups] for r in g}
         chain.pending = [r for r in chain.pending if r.seq not in fixed]
         chain.min_start = min((r.start for r in chain.pending), default=math.inf)
         chain.last_fixed_t = groups[n_groups - 1][0].note.time_s
+        self._gates[chain.name].forget_before(chain.last_fixed_t)
         chain.fixed = chain.fixed[-HISTORY:]
 
     def _emit(self, chain: _Chain, rec: _Rec, **kw: Any) -> PlannedNote:
@@ -333,13 +347,15 @@ class OnlinePlanner:
         return pitches[:kept], options
 
     def _fix_bass(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
-        prepared = [self._bass_group(g) for g in groups]
-        if chain.plan is None:
-            sol = bass_mod.solve(chain.state, [opts for _, opts in prepared])
-            chain.plan = list(zip(sol.choice, sol.costs, sol.states, strict=True))
+        window = self.bounds.window_groups  # plan.bounds: one solve, at most this many groups
         for gi in range(n_groups):
-            kept, opts = prepared[gi]
-            choice, cost, state = chain.plan[gi]
+            kept, opts = self._bass_group(groups[gi])
+            if not chain.plan:  # none yet, or the window's plan is used up: solve the next
+                sol = bass_mod.solve(
+                    chain.state, [self._bass_group(g)[1] for g in groups[gi : gi + window]]
+                )
+                chain.plan = list(zip(sol.choice, sol.costs, sol.states, strict=True))
+            choice, cost, state = chain.plan.pop(0)
             self._emit_bass_group(chain, groups[gi], kept, opts[choice], cost)
             chain.state = state
 
@@ -459,17 +475,23 @@ class OnlinePlanner:
         for g in groups:
             self._decide_foot(g, rebounds)
         aside = rebounds | {r.seq for r in chain.pending if r.to_foot}
-        prepared = [
-            self._hand_group([r for r in g if r.seq not in aside], g[0].note.time_s) for g in groups
-        ]
-        if chain.plan is None:
-            sol = drums_mod.solve(
-                self.config.costs, self.config.timing, chain.state, [p.group for p in prepared]
-            )
-            chain.plan = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+
+        def prepare(g: list[_Rec]) -> _HandGroupPlan:
+            return self._hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
+
+        window = self.bounds.window_groups  # plan.bounds: one solve, at most this many groups
         for gi in range(n_groups):
-            hp = prepared[gi]
-            assignment, stroke_costs, state = chain.plan[gi]
+            hp = prepare(groups[gi])
+            if not chain.plan:  # none yet, or the window's plan is used up: solve the next
+                sol = drums_mod.solve(
+                    self.config.costs,
+                    self.config.timing,
+                    chain.state,
+                    [prepare(g).group for g in groups[gi : gi + window]],
+                    beam=self.bounds.beam,
+                )
+                chain.plan = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+            assignment, stroke_costs, state = chain.plan.pop(0)
             for r in hp.extra:
                 if not self._foot_chick(r):
                     self._drop(r, "too_many_hands")
@@ -744,13 +766,14 @@ def plan_notes_with_report(
     *,
     lookahead_beats: float = 1.0,
     config: PlanConfig | None = None,
+    bounds: PlanBounds = DEFAULT_BOUNDS,
 ) -> tuple[list[PlannedNote], PlanReport]:
     """Plan a whole performance as the live daemon would, and the report.
 
     Each note is revealed at :func:`reveal_time`; in reveal order the planner is
     polled at that time and then given the note; finally flushed.
     """
-    planner = OnlinePlanner(config, tempo=tempo)
+    planner = OnlinePlanner(config, tempo=tempo, bounds=bounds)
     order = sorted(
         range(len(notes)), key=lambda i: reveal_time(notes[i][1], tempo, lookahead_beats)
     )

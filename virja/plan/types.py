@@ -103,6 +103,8 @@ DropReason = Literal[
     "no_free_limb",  # came after later notes of its limbs were fixed, and no limb was free then
     "unmapped",  # a drum note outside the kit map
     "no_double_stop",  # a simultaneous bass note that cannot be stopped with the melody note
+    "too_dense",  # more notes of its limbs around its time than anyone plays (plan.bounds)
+    "planner_full",  # its limbs already had the most notes a plan may wait on (plan.bounds)
 ]
 
 

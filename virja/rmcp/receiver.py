@@ -22,6 +22,7 @@ from typing import Any
 
 from virja.events import Event, NoteOn
 from virja.rmcp.bodies import ClockRequestBody, UnknownBody
+from virja.rmcp.budget import Budget, PeerBudgets, peer_of
 from virja.rmcp.errors import RmcpError
 from virja.rmcp.seqnum import SeqWindow, seq_add, seq_diff
 from virja.rmcp.signing import sign
@@ -44,6 +45,8 @@ class ReceiverConfig:
     sender_id: this endpoint's own sender id, used in the clock replies it sends.
     answer_clock: whether CLOCK_REQUESTs are answered.
     max_queue: at most this many undelivered events are kept (oldest dropped).
+    budget: per-peer datagram, byte and note rates and the clock-reply rate
+        (virja.rmcp.budget); None: unlimited.
     """
 
     horizon_s: float = 10.0
@@ -54,6 +57,7 @@ class ReceiverConfig:
     sender_id: int = 0
     answer_clock: bool = True
     max_queue: int = 65536
+    budget: Budget | None = Budget()
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,6 +117,8 @@ class Receiver:
         self._seq = 0
         self._horizon_us = round(self.config.horizon_s * 1_000_000)
         self._max_age_us = round(self.config.max_age_s * 1_000_000)
+        budget = self.config.budget
+        self._budgets = PeerBudgets(budget) if budget is not None else None
 
     # -- input -----------------------------------------------------------------
 
@@ -129,6 +135,10 @@ class Receiver:
             log.exception("internal error on a datagram from %s", addr)
 
     def _receive(self, data: bytes, addr: Addr, now_us: int) -> None:
+        # the budget first: a peer over it costs a dictionary look-up, not a parse
+        if self._budgets is not None and not self._budgets.admit(peer_of(addr), len(data), now_us):
+            self.stats.dropped["rate_limited"] += 1
+            return
         dgram = Datagram.parse(data)
         key = self.config.key
         state = self._senders.get(dgram.sender)
@@ -183,8 +193,12 @@ class Receiver:
             self.stats.dropped["unknown_kind"] += 1
             return
         if isinstance(body, ClockRequestBody):
-            if self.config.answer_clock:
-                self._clock_requests.append((body, addr, now_us))
+            if not self.config.answer_clock:
+                return
+            if self._budgets is not None and not self._budgets.clock_reply(now_us):
+                self.stats.dropped["clock_rate_limited"] += 1
+                return
+            self._clock_requests.append((body, addr, now_us))
             return
         time_us = now_us if dgram.immediate else dgram.time_us
         if time_us - now_us > self._horizon_us:
@@ -196,10 +210,20 @@ class Receiver:
         now_s = us_to_s(now_us)
         late = time_us < now_us
         too_late = now_us - time_us > round(self.config.lateness_s * 1_000_000)
+        allowed = len(events)  # note-ons within the peer's note budget
+        if self._budgets is not None and not too_late:
+            n_on = sum(isinstance(ev, NoteOn) for ev in events)
+            if n_on:
+                allowed = self._budgets.notes(peer_of(addr), n_on, now_us)
         for ev in events:
-            if too_late and isinstance(ev, NoteOn):
-                self.stats.dropped["too_late"] += 1
-                continue
+            if isinstance(ev, NoteOn):
+                if too_late:
+                    self.stats.dropped["too_late"] += 1
+                    continue
+                if allowed <= 0:
+                    self.stats.dropped["note_flood"] += 1
+                    continue
+                allowed -= 1
             if len(self._events) >= self.config.max_queue:
                 self._events.popleft()
                 self.stats.dropped["queue_full"] += 1
@@ -241,3 +265,8 @@ class Receiver:
     @property
     def tracked_senders(self) -> int:
         return len(self._senders)
+
+    @property
+    def tracked_peers(self) -> int:
+        """Source addresses with budgets (at most the budget's ``max_peers``)."""
+        return len(self._budgets) if self._budgets is not None else 0

@@ -14,6 +14,7 @@ as ``virja plan --json`` prints it, written and flushed as notes are committed.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 from collections import Counter
@@ -66,6 +67,7 @@ class Performance:
         self.hud = HudTimeline()  # tempo, bar.beat and chord for the heads-up display
         self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
         self.planned_taps: list[Callable[[PlannedNote], None]] = []  # and every note committed
+        self.plan_log_failed: str | None = None
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""
@@ -125,15 +127,31 @@ class Performance:
             if self.animator is not None:
                 self.animator.add_planned(p)
             if self.plan_log is not None:
-                self.plan_log.write(json.dumps(p.to_json()) + "\n")
+                self._log(json.dumps(p.to_json()) + "\n")
             if self.keep_planned:
                 self.planned.append(p)
             self.counts["planned"] += 1
             if p.late:
                 self.counts["planned_late"] += 1
         if notes and self.plan_log is not None:
-            self.plan_log.flush()
+            self._log(None)
         return notes
+
+    def _log(self, line: str | None) -> None:
+        """Write ``line`` to the plan log (None: flush).  A write that fails (a full
+        disk) stops the log, reported once in ``plan_log_failed``; the band goes on."""
+        assert self.plan_log is not None
+        try:
+            if line is None:
+                self.plan_log.flush()
+            else:
+                self.plan_log.write(line)
+        except (OSError, ValueError) as exc:
+            self.plan_log_failed = getattr(exc, "strerror", None) or str(exc)
+            log.warning("plan log stopped: %s (planning goes on)", self.plan_log_failed)
+            with contextlib.suppress(OSError, ValueError):
+                self.plan_log.close()
+            self.plan_log = None
 
     def pose(self, time_s: float) -> BandPose:
         pose = getattr(self.animator, "pose", None)

@@ -31,6 +31,7 @@ from virja.cli.common import add_routing_arguments, finite_float, make_router, o
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import load_config
 from virja.errors import ConfigError
+from virja.faults import survive_tick
 
 STATUS_EVERY_S = 5.0
 RECORDER_FLUSH_S = 0.1  # the recording is flushed this often while it is open
@@ -205,6 +206,11 @@ class Daemon:
             )
         else:
             lines.append("clock offset: 0 (no --clock-server; local clock is the session clock)")
+        failed = getattr(self.recorder, "failed", None)
+        if failed:
+            lines.append(f"recording stopped early: {failed} (what was written is readable)")
+        if self.perf.plan_log_failed:
+            lines.append(f"plan log stopped early: {self.perf.plan_log_failed}")
         return lines
 
 
@@ -355,23 +361,25 @@ async def serve(args: argparse.Namespace) -> int:
         next_status = time.monotonic() + STATUS_EVERY_S
         while not stop.is_set():
             timer.arm()
-            daemon.tick()
-            now_s = clock.now_s()
-            deadlines = [perf.planner.next_deadline()]
-            if web is not None:  # a frame for the browsers when one is due
-                web.publish(perf, now_s)
-                sinks.forget_before(now_s - KEEP_MOTION_S)
-                deadlines.append(now_s + (1 / web.fps if web.server.viewers else WEB_IDLE_S))
-            if daemon.recorder is not None:
-                deadlines.append(now_s + RECORDER_FLUSH_S)
-            if viewer is not None and daemon.clock_client is not None:
-                viewer.sync_clock()
-                deadlines.append(now_s + CLOCK_SYNC_S)
-            if not args.quiet:
-                if time.monotonic() >= next_status:
-                    next_status = time.monotonic() + STATUS_EVERY_S
-                    print(f"virja serve: {daemon.status()}", file=sys.stderr, flush=True)
-                deadlines.append(now_s + next_status - time.monotonic())
+            deadlines: list[float] = []  # what a failed tick did not get to: MAX_SLEEP_S
+            with survive_tick():  # one tick's exception is reported; the next tick runs
+                daemon.tick()
+                now_s = clock.now_s()
+                deadlines.append(perf.planner.next_deadline())
+                if web is not None:  # a frame for the browsers when one is due
+                    web.publish(perf, now_s)
+                    sinks.forget_before(now_s - KEEP_MOTION_S)
+                    deadlines.append(now_s + (1 / web.fps if web.server.viewers else WEB_IDLE_S))
+                if daemon.recorder is not None:
+                    deadlines.append(now_s + RECORDER_FLUSH_S)
+                if viewer is not None and daemon.clock_client is not None:
+                    viewer.sync_clock()
+                    deadlines.append(now_s + CLOCK_SYNC_S)
+                if not args.quiet:
+                    if time.monotonic() >= next_status:
+                        next_status = time.monotonic() + STATUS_EVERY_S
+                        print(f"virja serve: {daemon.status()}", file=sys.stderr, flush=True)
+                    deadlines.append(now_s + next_status - time.monotonic())
             await timer.sleep(wake_in(deadlines, clock.now_s()))
 
     tasks.append(asyncio.create_task(ticker()))
@@ -386,16 +394,23 @@ async def serve(args: argparse.Namespace) -> int:
         transport.close()
         if viewer is not None:
             loop.remove_reader(viewer.sentinel)
-        daemon.tick()
-        perf.finish()  # notes planned ahead of the stop are logged too, as replay logs them
+        # each step on its own: a failure is one warning, and the summary still comes
+        with survive_tick():
+            daemon.tick()
+        with survive_tick():
+            perf.finish()  # notes planned ahead of the stop are logged too, as replay logs them
         if daemon.recorder is not None:
-            daemon.recorder.close()
+            with survive_tick():
+                daemon.recorder.close()
         if plan_log is not None:
-            plan_log.close()
+            with survive_tick():
+                plan_log.close()
         if viewer is not None:
-            viewer.close()
+            with survive_tick():
+                viewer.close()
         if web is not None:
-            web.close()
+            with survive_tick():
+                web.close()
     print("virja serve: stopped")
     for line in daemon.summary() + ([web.summary()] if web is not None else []):
         print(f"  {line}")

@@ -14,7 +14,10 @@ warning; a malformed file raises InputFileError naming it.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
+import os
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -74,6 +77,12 @@ class PcapWriter:
     ``local`` is the (host, port) the datagrams were received on, written as
     the destination.  Call :meth:`tick` with the current time when idle so the
     buffer is flushed within ``flush_interval_s`` even without traffic.
+
+    A write that fails (a full disk, an I/O error) never reaches the caller: the
+    recording stops there, ``failed`` says why (logged once as a warning), and
+    the file is cut back to the last record that was flushed whole, so it stays
+    readable.  A time that does not fit a pcap record (before 1970 or after
+    2106) skips that datagram.
     """
 
     def __init__(
@@ -85,8 +94,13 @@ class PcapWriter:
         self._last_flush_us: int | None = None
         self._dirty = False
         self._ident = 0
+        self._written = 0  # bytes handed to the stream
+        self._flushed = 0  # of those, the bytes known to be in the file (whole records)
+        self.failed: str | None = None
+        self.skipped = 0
         stream.write(PCAP_HEADER.pack(PCAP_MAGIC_US, 2, 4, 0, 0, SNAPLEN, LINKTYPE_RAW))
         stream.flush()
+        self._written = self._flushed = PCAP_HEADER.size
 
     @classmethod
     def open(cls, path: str | Path, *, local: tuple[str, int]) -> PcapWriter:
@@ -94,12 +108,18 @@ class PcapWriter:
             stream = open(path, "wb")  # noqa: SIM115 - closed by close()
         except OSError as exc:
             raise InputFileError(path, f"cannot write recording: {exc.strerror or exc}") from None
-        return cls(stream, local=local)
+        try:
+            return cls(stream, local=local)
+        except OSError as exc:
+            stream.close()
+            raise InputFileError(path, f"cannot write recording: {exc.strerror or exc}") from None
 
     def write(
         self, payload: bytes, src: tuple[str, int] | tuple[str, int, int, int], *, time_us: int
     ) -> None:
         """Append one received datagram from ``src`` stamped ``time_us``."""
+        if self.failed is not None:
+            return
         self._ident = (self._ident + 1) & 0xFFFF
         try:
             pkt = udp_packet(src[0], src[1], self._local[0], self._local[1], payload, self._ident)
@@ -107,7 +127,17 @@ class PcapWriter:
             log.warning("not recording a datagram from non-IP source %r", src)
             return
         sec, usec = divmod(time_us, 1_000_000)
-        self._stream.write(PCAP_RECORD.pack(sec, usec, len(pkt), len(pkt)) + pkt)
+        try:
+            record = PCAP_RECORD.pack(sec, usec, len(pkt), len(pkt)) + pkt
+        except struct.error:
+            self.skipped += 1
+            return
+        try:
+            self._stream.write(record)
+        except (OSError, ValueError) as exc:
+            self._fail(exc)
+            return
+        self._written += len(record)
         self._dirty = True
         self.tick(time_us)
 
@@ -120,12 +150,42 @@ class PcapWriter:
             self._last_flush_us = now_us
 
     def flush(self) -> None:
-        self._stream.flush()
+        if self.failed is not None:
+            return
+        try:
+            self._stream.flush()
+        except (OSError, ValueError) as exc:
+            self._fail(exc)
+            return
+        self._flushed = self._written
         self._dirty = False
 
+    def _fail(self, exc: Exception) -> None:
+        """Stop recording: report once, cut the file back to whole records, close it."""
+        reason = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
+        self.failed = reason
+        log.warning(
+            "recording stopped: %s (kept %d bytes of whole records; receiving goes on)",
+            reason,
+            self._flushed,
+        )
+        fd = None
+        with contextlib.suppress(OSError, ValueError, AttributeError, io.UnsupportedOperation):
+            fd = os.dup(self._stream.fileno())
+        with contextlib.suppress(OSError, ValueError):
+            self._stream.close()  # its flush may fail again; the file is closed anyway
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.ftruncate(fd, self._flushed)
+            os.close(fd)
+
     def close(self) -> None:
-        self._stream.flush()
-        self._stream.close()
+        if self.failed is not None:
+            return
+        self.flush()
+        if self.failed is None:
+            with contextlib.suppress(OSError, ValueError):
+                self._stream.close()
 
     def __enter__(self) -> PcapWriter:
         return self

@@ -20,7 +20,7 @@ import struct
 from collections.abc import Callable
 from typing import Any, cast
 
-from virja.clock import ClockEstimator, SessionClock
+from virja.clock import ClockEstimator, ClockGuard, SessionClock
 from virja.errors import ConfigError
 from virja.rmcp import DEFAULT_PORT
 from virja.rmcp.bodies import ClockReplyBody
@@ -184,7 +184,11 @@ class RmcpProtocol(asyncio.DatagramProtocol):
         """One datagram that arrived at ``now_us`` (session clock; the kernel's
         stamp of its arrival where :mod:`virja.rmcp.stamped` has one)."""
         if self.recorder is not None:
-            self.recorder.write(data, addr, time_us=now_us)
+            try:  # PcapWriter stops itself on a disk fault; anything else stops it here
+                self.recorder.write(data, addr, time_us=now_us)
+            except Exception:
+                log.exception("recording stopped by an internal error; receiving goes on")
+                self.recorder = None
         self.receiver.receive_datagram(data, addr, now_us=now_us)
         events = self.receiver.drain_events()
         if events:
@@ -222,8 +226,10 @@ class _ClockClientProtocol(asyncio.DatagramProtocol):
 class ClockClient:
     """Sends CLOCK_REQUESTs to a clock server every ``interval_s`` and keeps an estimate.
 
-    After each reply the clock's ``offset_us`` is set from the estimate, so
-    ``clock.now_us()`` follows the server.
+    After each reply the clock's ``offset_us`` is set from the estimate when
+    :class:`~virja.clock.ClockGuard` allows it, so ``clock.now_us()`` follows the
+    server but no single reply can move it far; each kind of refusal is logged
+    once as a warning and counted in ``refused``.
     """
 
     def __init__(
@@ -235,6 +241,7 @@ class ClockClient:
         key: bytes | None = None,
         interval_s: float = 1.0,
         estimator: ClockEstimator | None = None,
+        guard: ClockGuard | None = None,
     ) -> None:
         self.server = server
         self.clock = clock
@@ -242,6 +249,8 @@ class ClockClient:
         self.key = key
         self.interval_s = interval_s
         self.estimator = estimator or ClockEstimator()
+        self.guard = guard or ClockGuard()
+        self.refused: dict[str, int] = {}
         self._pending: dict[int, int] = {}
         self._seq = random.getrandbits(32)
         self._transport: asyncio.DatagramTransport | None = None
@@ -276,7 +285,22 @@ class ClockClient:
             return False
         est = self.estimator.estimate(t3_us)
         if est is not None:
-            self.clock.offset_us = round(est.offset_us)
+            recent = self.estimator.recent_offsets(self.guard.agree)
+            offset, refusal = self.guard.decide(self.clock.offset_us, est.offset_us, recent)
+            if offset is not None:
+                self.clock.offset_us = offset
+            elif refusal is not None:
+                if refusal not in self.refused:
+                    (log.warning if refusal == "panic" else log.info)(
+                        "clock server %s: offset %+.3f s refused (%s); the clock keeps %+.3f s",
+                        self.server[0],
+                        est.offset_us / 1e6,
+                        "beyond the panic threshold"
+                        if refusal == "panic"
+                        else "a step not yet confirmed",
+                        self.clock.offset_us / 1e6,
+                    )
+                self.refused[refusal] = self.refused.get(refusal, 0) + 1
         return True
 
     async def run(self) -> None:
@@ -288,7 +312,10 @@ class ClockClient:
         self._transport = transport
         try:
             while True:
-                transport.sendto(self.request())
+                try:
+                    transport.sendto(self.request())
+                except Exception as exc:  # one failed request must not stop the asking
+                    log.warning("clock client: request not sent: %s", exc)
                 await asyncio.sleep(self.interval_s)
         finally:
             transport.close()

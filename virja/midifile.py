@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import mido
+from mido.midifiles.meta import KeySignatureError
 
 from virja.chords import parse_chord_symbol
 from virja.errors import InputFileError
@@ -107,8 +108,18 @@ def _open(path: Path) -> mido.MidiFile:
         raise InputFileError(path, "is a folder, not a MIDI file")
     try:
         return mido.MidiFile(str(path), clip=False)
-    except (OSError, EOFError, ValueError, KeyError, IndexError, TypeError) as exc:
+    except (
+        OSError,
+        EOFError,
+        ValueError,
+        KeyError,
+        IndexError,
+        TypeError,
+        KeySignatureError,  # a plain Exception: a key signature's mode byte not 0 or 1
+    ) as exc:
         why = str(exc) or type(exc).__name__
+        if isinstance(exc, KeySignatureError):
+            why = f"bad key signature ({why or 'mode not major/minor'})"
         raise InputFileError(path, f"not a readable MIDI file: {why}") from exc
 
 

@@ -43,6 +43,9 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
+MAX_FRAMES = 1_000_000  # about 9 hours at 30 fps: a longer span is a mistake, not a song
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "input", metavar="INPUT", help="a MIDI file (.mid) or an RMCP recording (.pcap, .pcapng)"
@@ -205,6 +208,11 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
             args.at,
             first_s,
             last_s,
+        )
+    if (t1 - t0) * args.fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
+        raise ConfigError(
+            f"the span {t0:.3f} .. {t1:.3f} s is {(t1 - t0) * args.fps:.0f} frames, more than "
+            f"{MAX_FRAMES:,}; pick a part with --start and --end"
         )
     dancer_db = getattr(args, "dancer", None)
     with temp_workdir() as tmp:

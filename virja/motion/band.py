@@ -21,6 +21,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from virja.errors import ConfigError
 from virja.events import Beat
 from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, DRUM_PIECES, GEOMETRY, Geometry
 from virja.motion import quat
@@ -110,22 +111,46 @@ class AnimationSettings:
             path = motions_dir() / "animation.toml"
         if not path.is_file():
             return cls()
-        d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
-        k = d.get("kit", {})
-        return cls(
-            vel_floor=d["velocity"]["floor"],
-            vel_ceiling=d["velocity"]["ceiling"],
-            reference_spb=d["tempo"]["reference_spb"],
-            max_rate=d["tempo"]["max_rate"],
-            nod_rad=d["idle"]["nod_rad"],
-            sway_rad=d["idle"]["sway_rad"],
-            sway_period_s=d["idle"]["sway_period_s"],
-            head_decay_s=k["head_decay_s"],
-            swing=tuple(_swing(p, k[f"{p}_swing"]) for p in ("ride", "crash", "hihat")),
-            hihat_travel_m=k["hihat_travel_m"],
-            string_amp_m=d["strings"]["amplitude_m"],
-            string_decay_s=d["strings"]["decay_s"],
-        )
+        where = str(path)
+        try:
+            d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
+        except UnicodeDecodeError:
+            raise ConfigError(f"{where}: not UTF-8 text") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"{where}: invalid TOML: {exc}") from None
+        except OSError as exc:
+            raise ConfigError(f"{where}: cannot read: {exc.strerror or exc}") from None
+        try:
+            k = d.get("kit", {})
+            settings = cls(
+                vel_floor=float(d["velocity"]["floor"]),
+                vel_ceiling=float(d["velocity"]["ceiling"]),
+                reference_spb=float(d["tempo"]["reference_spb"]),
+                max_rate=float(d["tempo"]["max_rate"]),
+                nod_rad=float(d["idle"]["nod_rad"]),
+                sway_rad=float(d["idle"]["sway_rad"]),
+                sway_period_s=float(d["idle"]["sway_period_s"]),
+                head_decay_s=float(k["head_decay_s"]),
+                swing=tuple(_swing(p, k[f"{p}_swing"]) for p in ("ride", "crash", "hihat")),
+                hihat_travel_m=float(k["hihat_travel_m"]),
+                string_amp_m=float(d["strings"]["amplitude_m"]),
+                string_decay_s=float(d["strings"]["decay_s"]),
+            )
+        except KeyError as exc:
+            raise ConfigError(f"{where}: missing key {exc.args[0]!r}") from None
+        except (TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise ConfigError(f"{where}: a value has the wrong type or shape: {exc}") from None
+        positive = {
+            "tempo.reference_spb": settings.reference_spb,
+            "tempo.max_rate": settings.max_rate,
+            "idle.sway_period_s": settings.sway_period_s,
+            "kit.head_decay_s": settings.head_decay_s,
+            "strings.decay_s": settings.string_decay_s,
+        }
+        for name, value in positive.items():
+            if not (math.isfinite(value) and value > 0):
+                raise ConfigError(f"{where}: {name} must be a finite number > 0, got {value}")
+        return settings
 
 
 def _swing(piece: str, v: list[float]) -> tuple[str, float, float, float]:

@@ -40,7 +40,7 @@ class PlanBounds:
     span_s: float = DENSE_SPAN_S
     max_notes: int = 32  # per chain within span_s either side of a note
     max_pending: int = 1024  # notes waiting per chain
-    window_groups: int = 32  # groups per solve
+    window_groups: int = 16  # groups per solve
     beam: int = 64  # states per DP layer (drums' hands; real drumming needs 45)
 
     def __post_init__(self) -> None:

@@ -2,9 +2,10 @@
 
 Each source address (host, port) gets token buckets for datagrams, bytes and
 note-ons per second; what exceeds them is dropped by reason before the costly
-work: ``rate_limited`` (datagram or byte budget) before a datagram is parsed,
-``note_flood`` (note budget) for each note-on beyond it, so a 1,200-byte
-datagram of 400 notes costs its header check and a count, not 400 plans.
+work: ``rate_limited`` (datagram or byte budget) before a datagram is parsed;
+``note_flood`` (note budget) for each note-on beyond it, and for a whole MIDI
+datagram, unparsed, from a peer whose note budget is already spent -- so a
+1,200-byte datagram of 400 notes costs a header peek, not a parse and 400 plans.
 Clock replies owed to anyone have one shared budget (``clock_rate_limited``):
 a forged source cannot turn the receiver into an amplifier.
 
@@ -22,16 +23,18 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Budget:
-    """Rates per peer (per second); each bucket holds ``burst_s`` seconds of its rate.
+    """Rates per peer (per second); each bucket holds ``burst_s`` seconds of its rate
+    (the note bucket ``notes_burst`` notes).
 
     The defaults are far above what a band sends (a dense drum part is about
-    100 datagrams, 4 KB and 50 notes a second) and well below what the
-    daemon can plan.
+    100 datagrams, 4 KB and 50 notes a second, a chord 10 notes at once) and
+    well below what the daemon can plan.
     """
 
     datagrams_per_s: float = 1000.0
-    bytes_per_s: float = 256_000.0
-    notes_per_s: float = 500.0
+    bytes_per_s: float = 64_000.0
+    notes_per_s: float = 200.0
+    notes_burst: int = 64  # at most this many note-ons at once (a datagram's worth)
     clock_replies_per_s: float = 100.0  # all peers together
     burst_s: float = 1.0
     max_peers: int = 1024
@@ -40,8 +43,8 @@ class Budget:
         rates = (self.datagrams_per_s, self.bytes_per_s, self.notes_per_s)
         if not all(r > 0 for r in rates) or not self.clock_replies_per_s >= 0:
             raise ValueError("budget rates must be > 0 (clock replies >= 0)")
-        if not self.burst_s > 0 or self.max_peers < 1:
-            raise ValueError("burst_s must be > 0 and max_peers >= 1")
+        if not self.burst_s > 0 or self.max_peers < 1 or self.notes_burst < 1:
+            raise ValueError("burst_s must be > 0, max_peers and notes_burst >= 1")
 
 
 class Bucket:
@@ -82,7 +85,7 @@ class _Peer:
     def __init__(self, b: Budget, now_us: int) -> None:
         self.datagrams = Bucket(b.datagrams_per_s, b.datagrams_per_s * b.burst_s, now_us)
         self.bytes = Bucket(b.bytes_per_s, b.bytes_per_s * b.burst_s, now_us)
-        self.notes = Bucket(b.notes_per_s, b.notes_per_s * b.burst_s, now_us)
+        self.notes = Bucket(b.notes_per_s, b.notes_burst, now_us)
 
 
 class PeerBudgets:
@@ -116,6 +119,14 @@ class PeerBudgets:
     def notes(self, peer: Hashable, n: int, now_us: int) -> int:
         """How many of ``n`` note-ons from ``peer`` fit its note budget (taken)."""
         return self._peer(peer, now_us).notes.take_up_to(n, now_us)
+
+    def out_of_notes(self, peer: Hashable, now_us: int) -> bool:
+        """Whether ``peer``'s note budget is spent (its next note-on would be shed)."""
+        p = self._peers.get(peer)
+        if p is None:
+            return False
+        p.notes._refill(now_us)
+        return p.notes.tokens < 1
 
     def clock_reply(self, now_us: int) -> bool:
         """Whether one more clock reply may be sent now (shared by all peers)."""

@@ -17,16 +17,18 @@ import hashlib
 import hmac
 import logging
 from collections import Counter, OrderedDict, deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from virja.events import Event, NoteOn
-from virja.rmcp.bodies import ClockRequestBody, UnknownBody
+from virja.rmcp.bodies import ClockRequestBody, MidiBody, UnknownBody
 from virja.rmcp.budget import Budget, PeerBudgets, peer_of
 from virja.rmcp.errors import RmcpError
 from virja.rmcp.seqnum import SeqWindow, seq_add, seq_diff
 from virja.rmcp.signing import sign
-from virja.rmcp.wire import TAG_LEN, Datagram, clock_reply, kind_name, to_events, us_to_s
+from virja.rmcp.wire import TAG_LEN, Datagram, Kind, clock_reply, kind_name, to_events, us_to_s
+
+KIND_AT = 5  # the kind byte's offset in the header (after magic and version)
 
 log = logging.getLogger(__name__)
 
@@ -136,9 +138,17 @@ class Receiver:
 
     def _receive(self, data: bytes, addr: Addr, now_us: int) -> None:
         # the budget first: a peer over it costs a dictionary look-up, not a parse
-        if self._budgets is not None and not self._budgets.admit(peer_of(addr), len(data), now_us):
-            self.stats.dropped["rate_limited"] += 1
-            return
+        budgets = self._budgets
+        if budgets is not None:
+            peer = peer_of(addr)
+            if not budgets.admit(peer, len(data), now_us):
+                self.stats.dropped["rate_limited"] += 1
+                return
+            # a peer out of note budget: its MIDI is shed unparsed (the kind byte peeked)
+            midi = len(data) > KIND_AT and data[KIND_AT] == Kind.MIDI
+            if midi and budgets.out_of_notes(peer, now_us):
+                self.stats.dropped["note_flood"] += 1
+                return
         dgram = Datagram.parse(data)
         key = self.config.key
         state = self._senders.get(dgram.sender)
@@ -204,26 +214,18 @@ class Receiver:
         if time_us - now_us > self._horizon_us:
             self.stats.dropped["beyond_horizon"] += 1
             return
+        too_late = now_us - time_us > round(self.config.lateness_s * 1_000_000)
+        if self._budgets is not None and not too_late and isinstance(body, MidiBody):
+            dgram = self._within_note_budget(dgram, body, addr, now_us)
         events = to_events(dgram, time_s=us_to_s(time_us))
         if not events:
             return
         now_s = us_to_s(now_us)
         late = time_us < now_us
-        too_late = now_us - time_us > round(self.config.lateness_s * 1_000_000)
-        allowed = len(events)  # note-ons within the peer's note budget
-        if self._budgets is not None and not too_late:
-            n_on = sum(isinstance(ev, NoteOn) for ev in events)
-            if n_on:
-                allowed = self._budgets.notes(peer_of(addr), n_on, now_us)
         for ev in events:
-            if isinstance(ev, NoteOn):
-                if too_late:
-                    self.stats.dropped["too_late"] += 1
-                    continue
-                if allowed <= 0:
-                    self.stats.dropped["note_flood"] += 1
-                    continue
-                allowed -= 1
+            if too_late and isinstance(ev, NoteOn):
+                self.stats.dropped["too_late"] += 1
+                continue
             if len(self._events) >= self.config.max_queue:
                 self._events.popleft()
                 self.stats.dropped["queue_full"] += 1
@@ -231,6 +233,23 @@ class Receiver:
             self.stats.events += 1
             if late:
                 self.stats.late += 1
+
+    def _within_note_budget(
+        self, dgram: Datagram, body: MidiBody, addr: Addr, now_us: int
+    ) -> Datagram:
+        """``dgram`` without the note-ons beyond its peer's note budget (counted as
+        ``note_flood``); they are cut from the messages before any event is made."""
+        assert self._budgets is not None
+        ons = [i for i, m in enumerate(body.messages) if m[0] & 0xF0 == 0x90 and m[2]]
+        if not ons:
+            return dgram
+        allowed = self._budgets.notes(peer_of(addr), len(ons), now_us)
+        if allowed >= len(ons):
+            return dgram
+        cut = set(ons[allowed:])
+        self.stats.dropped["note_flood"] += len(cut)
+        kept = tuple(m for i, m in enumerate(body.messages) if i not in cut)
+        return replace(dgram, body=MidiBody(kept))
 
     # -- output ----------------------------------------------------------------
 

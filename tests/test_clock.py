@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import random
 
-from virja.clock import ClockEstimator, ClockSample, SessionClock
+from virja.clock import ClockEstimator, ClockGuard, ClockSample, SessionClock
 
 
 def test_sample_formulas() -> None:
@@ -63,3 +63,38 @@ def test_impossible_sample_rejected() -> None:
     est = ClockEstimator()
     assert est.add(10, 0, 0, 5) is None
     assert est.estimate() is None
+
+
+# -- hostile replies (docs/reliability.md) -------------------------------------
+
+
+def test_insane_samples_rejected_out_of_range_negative_or_huge_delay() -> None:
+    est = ClockEstimator(max_delay_s=1.0)
+    assert est.add(1000, 1 << 63, 1 << 63, 2000) is None  # outside i64
+    assert est.add(1000, 5_000, 5_000 + 10**12, 2000) is None  # t2 - t1 = 1e12: delay < 0
+    assert est.add(0, 0, 0, 2_000_000) is None  # a 2 s round trip
+    assert est.rejected == 3 and len(est) == 0
+    big = (1 << 63) - 1  # in range and ordered: a sample (the guard refuses its offset)
+    assert est.add(1000, big, big, 2000) is not None
+
+
+def test_one_forged_least_delay_sample_does_not_win() -> None:
+    est = ClockEstimator()
+    for i in range(5):  # honest: offset 0, delay 400 us
+        t0 = i * 1_000_000
+        est.add(t0, t0 + 200, t0 + 200, t0 + 400)
+    t0 = 6_000_000  # forged: delay 0, offset +2.5 days
+    est.add(t0, t0 + 216_000_000_000, t0 + 216_000_000_000, t0)
+    got = est.estimate()
+    assert got is not None and abs(got.offset_us) < 1000
+
+
+def test_guard_applies_small_corrections_confirms_steps_and_refuses_panics() -> None:
+    guard = ClockGuard(step_s=0.128, panic_s=1000.0, agree=3)
+    assert guard.decide(0, 40_000.0, [40_000.0]) == (40_000, None)
+    hour = 3600e6
+    assert guard.decide(0, hour, [hour]) == (None, "panic")
+    step = 5e6  # +5 s: a step, needs three samples that agree
+    assert guard.decide(0, step, [0.0, 0.0, step]) == (None, "unconfirmed_step")
+    assert guard.decide(0, step, [step, step, step]) == (5_000_000, None)
+    assert guard.decide(0, float("nan"), []) == (None, "panic")

@@ -242,3 +242,40 @@ def test_chords_go_out_as_chord_messages_from_the_conductor() -> None:
     assert (item.datagram.body.root, item.datagram.body.quality) == (10, "7")
     assert item.datagram.sender == options.conductor
     assert item.datagram.time_us == 3_000_000 and item.send_us < item.datagram.time_us
+
+
+def test_clock_client_refuses_hostile_replies_and_the_recorder_keeps_going(
+    tmp_path: object,
+) -> None:
+    """D2: t1 = t2 = 2^63-1, a negative delay, a +1 h shift: the clock stays, the
+    receiver and the recorder go on (docs/reliability.md)."""
+    from pathlib import Path
+
+    from virja.rmcp.bodies import ClockReplyBody, ClockRequestBody
+    from virja.rmcp.wire import Datagram, Flags
+    from virja.rmcp.pcap import PcapWriter, read_capture
+    from virja.rmcp.transport import ClockClient
+
+    local = SessionClock(wall_ns=lambda: START * 1000, monotonic_ns=lambda: 0)
+    client = ClockClient(("127.0.0.1", 1), local)
+
+    def reply(t1: int, t2: int) -> bytes:
+        req = Datagram.parse(client.request())
+        body = req.body
+        assert isinstance(body, ClockRequestBody)
+        out = ClockReplyBody(body.nonce, body.t0_us, t1, t2)
+        return bytes(Datagram(5, 1, START, out, Flags.IMMEDIATE))
+
+    big = (1 << 63) - 1
+    assert client.reply_received(reply(big, big), t3_us=START + 100)
+    assert local.offset_us == 0 and client.refused == {"panic": 1}
+    assert not client.reply_received(reply(START, START + 10**12), t3_us=START + 100)
+    hour = 3_600_000_000
+    for _ in range(2):  # a plausible +1 h shift, not (yet) confirmed by three samples
+        client.reply_received(reply(START + hour, START + hour), t3_us=START)
+    assert local.offset_us == 0
+    path = Path(str(tmp_path)) / "r.pcap"
+    with PcapWriter.open(path, local=("127.0.0.1", 50500)) as w:
+        w.write(b"x", ("127.0.0.1", 9), time_us=local.now_us())
+        w.write(b"y", ("127.0.0.1", 9), time_us=1 << 62)  # a time pcap cannot hold: skipped
+    assert len(read_capture(path).datagrams) == 1

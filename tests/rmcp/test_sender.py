@@ -252,9 +252,9 @@ def test_clock_client_refuses_hostile_replies_and_the_recorder_keeps_going(
     from pathlib import Path
 
     from virja.rmcp.bodies import ClockReplyBody, ClockRequestBody
-    from virja.rmcp.wire import Datagram, Flags
     from virja.rmcp.pcap import PcapWriter, read_capture
     from virja.rmcp.transport import ClockClient
+    from virja.rmcp.wire import Datagram, Flags
 
     local = SessionClock(wall_ns=lambda: START * 1000, monotonic_ns=lambda: 0)
     client = ClockClient(("127.0.0.1", 1), local)

@@ -11,7 +11,9 @@ planned, and late.
   1 s ahead), sent back to back;
 - ``act_now``: N x 1,000 datagrams of 1,200 bytes each, full of note-ons
   marked IMMEDIATE, at 1,000 a second;
-- ``senders``: N x 65,536 sender ids sending 16 program changes each (memory).
+- ``senders``: N x 65,536 sender ids sending 16 program changes each, from
+  40,000 source ports (memory; the state caps, not the budgets, are what holds);
+- ``sigterm`` (not by default): a real ``virja serve`` flooded, then SIGTERM.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import argparse
 import resource
 import statistics
 import time
+from array import array
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -46,6 +49,7 @@ class Result:
     worst_ms: float
     tick_worst_ms: float
     rss_growth_mb: float
+    rss_quarters: list[float]
     bass_sent: int
     bass_planned: int
     bass_late: int
@@ -57,7 +61,8 @@ class Result:
             f"{self.name}{'' if self.budget else ' (no budget)'} x{self.scale}: {self.datagrams} datagrams, CPU per datagram median "
             f"{self.median_ms:.3f} ms, worst {self.worst_ms:.2f} ms (a tick's worst "
             f"{self.tick_worst_ms:.2f} ms); peak RSS +"
-            f"{self.rss_growth_mb:.1f} MB; bass {self.bass_planned}/{self.bass_sent} planned, "
+            f"{self.rss_growth_mb:.1f} MB (after each quarter of the attack: "
+            f"{', '.join(f'{r:.0f}' for r in self.rss_quarters)} MB); bass {self.bass_planned}/{self.bass_sent} planned, "
             f"{self.bass_late} late; drops: {top or 'none'}"
         )
 
@@ -92,8 +97,10 @@ def run(name: str, scale: int, *, budget: bool = True) -> Result:
     perf.keep_planned = True
     seqs = iter(range(1 << 30))
     bass_seq = iter(range(1 << 30))
-    times: list[float] = []
-    ticks: list[float] = []
+    times = array("d")  # 8 bytes a datagram: the bench's own growth
+    ticks = array("d")
+    rss_at: list[float] = []  # RSS after each quarter of the attack (memory flat?)
+    total = {"dense": 400 * scale, "act_now": 1000 * scale}.get(name, 65535 * 16 * scale)
     rss0 = _rss_mb()
 
     def handle(data: bytes, addr: tuple[str, int]) -> None:
@@ -124,8 +131,9 @@ def run(name: str, scale: int, *, budget: bool = True) -> Result:
         per_s = 1000.0 * scale
     else:
         attack = iter(
-            bytes(wire.midi(s, 0, start_us, bytes([0xC0 | ch, 33])))
+            bytes(wire.midi(s, ch, start_us, bytes([0xC0 | ch, 33])))
             for s in range(65536 * scale)
+            if s % 65536 != BASS_SENDER
             for ch in range(16)
         )
         per_s = 1e9
@@ -133,7 +141,8 @@ def run(name: str, scale: int, *, budget: bool = True) -> Result:
     next_bass = 0
     t_start = time.perf_counter()
     end = t_start + duration_s + 1.5
-    while time.perf_counter() < end:
+    done = False  # the attack sent in full
+    while time.perf_counter() < end or not done:
         elapsed = time.perf_counter() - t_start
         now_us = clock.now_us()
         while next_bass < len(bass_times) and bass_times[next_bass] - 500_000 <= now_us:
@@ -143,15 +152,21 @@ def run(name: str, scale: int, *, budget: bool = True) -> Result:
             next_bass += 1
         if sent_attack < elapsed * per_s:
             data = next(attack, None)
+            done = data is None
             if data is not None:
-                handle(data, ATTACKER_ADDR)
+                port = 20000 + sent_attack % 40000 if name == "senders" else ATTACKER_ADDR[1]
+                handle(data, (ATTACKER_ADDR[0], port))
                 sent_attack += 1
-                continue
+                if sent_attack % (total // 4) == 0:
+                    rss_at.append(_rss_mb())
+                if sent_attack % 64:
+                    continue
         t = time.thread_time()
         perf.advance(clock.now_us() / 1e6)  # the tick
         ticks.append(time.thread_time() - t)
         time.sleep(0.0005)
     perf.finish()
+    rss_end = _rss_mb()  # before the summary's own lists
     bass = [p for p in perf.planned if p.performer == "bass"]
     ms = [t * 1000 for t in times]
     drops = dict(receiver.stats.dropped)
@@ -163,12 +178,65 @@ def run(name: str, scale: int, *, budget: bool = True) -> Result:
         len(times),
         statistics.median(ms),
         max(ms),
-        max(ticks) * 1000,
-        _rss_mb() - rss0,
+        max(ticks, default=0.0) * 1000,
+        rss_end - rss0,
+        rss_at,
         len(bass_times),
         len(bass),
         sum(p.late for p in bass),
         drops,
+    )
+
+
+def sigterm(scale: int) -> str:
+    """A real ``virja serve --headless`` flooded (``scale`` x 400 dense datagrams and
+    ``scale`` x 100 act-now ones over a second), then SIGTERM: seconds to exit, the
+    exit status, whether the summary came."""
+    import os
+    import re
+    import signal
+    import socket
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "virja",
+            "serve",
+            "--headless",
+            "--quiet",
+            "--listen",
+            "127.0.0.1:0",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+    )
+    assert proc.stdout is not None
+    m = re.search(r":(\d+)", proc.stdout.readline())
+    if m is None:
+        proc.kill()
+        return "sigterm: the daemon did not start"
+    port = int(m.group(1))
+    clock = SessionClock()
+    now = clock.now_us()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
+        for data in _dense(scale, now, iter(range(1 << 30))):
+            tx.sendto(data, ("127.0.0.1", port))
+        for i, data in enumerate(_act_now(100 * scale, now)):
+            tx.sendto(data, ("127.0.0.1", port))
+            if i % 10 == 0:
+                time.sleep(0.1 / scale)
+    t = time.perf_counter()
+    proc.send_signal(signal.SIGTERM)
+    out, _err = proc.communicate(timeout=600)
+    took = time.perf_counter() - t
+    return (
+        f"sigterm x{scale}: exit {proc.returncode} in {took:.2f} s after SIGTERM, "
+        f"summary {'printed' if 'virja serve: stopped' in out else 'MISSING'}"
     )
 
 
@@ -183,7 +251,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("traffic", nargs="*", default=["dense", "act_now", "senders"])
     args = p.parse_args(argv)
     for name in args.traffic:
-        print(run(name, args.scale, budget=not args.no_budget).line(), flush=True)
+        if name == "sigterm":
+            print(sigterm(args.scale), flush=True)
+        else:
+            print(run(name, args.scale, budget=not args.no_budget).line(), flush=True)
     return 0
 
 

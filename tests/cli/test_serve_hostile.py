@@ -110,3 +110,22 @@ def test_plan_log_write_error_is_reported_once_and_planning_goes_on() -> None:
     assert perf.plan_log is None and log.closed
     assert perf.plan_log_failed == "No space left on device"
     assert json.dumps(planned[0].to_json())
+
+
+def test_a_failing_event_handler_does_not_close_the_socket() -> None:
+    from virja.rmcp.receiver import Receiver
+    from virja.rmcp.transport import RmcpProtocol
+
+    calls: list[int] = []
+
+    def boom(evs: object, now: float) -> None:
+        calls.append(1)
+        raise RuntimeError("a bug in a tick")
+
+    proto = RmcpProtocol(Receiver(), SessionClock(), boom)
+    now = SessionClock().now_us()
+    for i in range(3):
+        proto.datagram_received(
+            bytes(wire.midi(2, i, now + 500_000, bytes([0x99, 38, 90]))), ("127.0.0.1", 4)
+        )
+    assert len(calls) == 3  # every datagram handled, nothing escaped to asyncio

@@ -22,6 +22,7 @@ from typing import Any, cast
 
 from virja.clock import ClockEstimator, ClockGuard, SessionClock
 from virja.errors import ConfigError
+from virja.faults import survive_tick
 from virja.rmcp import DEFAULT_PORT
 from virja.rmcp.bodies import ClockReplyBody
 from virja.rmcp.errors import RmcpError
@@ -192,7 +193,9 @@ class RmcpProtocol(asyncio.DatagramProtocol):
         self.receiver.receive_datagram(data, addr, now_us=now_us)
         events = self.receiver.drain_events()
         if events:
-            self.on_events(events, now_us / 1_000_000)
+            # an exception here would make asyncio close the socket: report it, go on
+            with survive_tick():
+                self.on_events(events, now_us / 1_000_000)
         if self.transport is not None:
             for out, to in self.receiver.datagrams_to_send(now_us=self.clock.now_us()):
                 self.transport.sendto(out, to)

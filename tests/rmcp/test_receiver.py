@@ -260,7 +260,7 @@ def test_clock_reply_signed_when_keyed() -> None:
 
 
 def test_sender_state_is_bounded() -> None:
-    r = Receiver(ReceiverConfig(max_senders=16))
+    r = Receiver(ReceiverConfig(max_senders=16, budget=None))  # one address: no budget here
     for s in range(100):
         r.receive_datagram(note(0, NOW, sender=s), ADDR, now_us=NOW)
     assert r.tracked_senders == 16 and r.stats.senders_evicted == 84

@@ -14,7 +14,6 @@ as ``virja plan --json`` prints it, written and flushed as notes are committed.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 from collections import Counter
@@ -23,6 +22,7 @@ from dataclasses import dataclass
 from typing import IO, TYPE_CHECKING, Protocol
 
 from virja.events import Beat, Chord, Event, NoteOff, NoteOn, Performer
+from virja.faults import close_at_last_line
 from virja.hud import HudTimeline
 from virja.routing import Router
 from virja.tempo import Tempo
@@ -149,8 +149,7 @@ class Performance:
         except (OSError, ValueError) as exc:
             self.plan_log_failed = getattr(exc, "strerror", None) or str(exc)
             log.warning("plan log stopped: %s (planning goes on)", self.plan_log_failed)
-            with contextlib.suppress(OSError, ValueError):
-                self.plan_log.close()
+            close_at_last_line(self.plan_log)
             self.plan_log = None
 
     def pose(self, time_s: float) -> BandPose:

@@ -168,3 +168,29 @@ def test_a_recording_spanning_years_is_refused_by_render_in_one_line(
     assert rc != 0
     assert "--start and --end" in err and "Traceback" not in err
     assert not (tmp_path / "frames").exists() or not any((tmp_path / "frames").iterdir())
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(room=st.integers(0, 3000))
+def test_a_plan_log_on_a_disk_full_at_any_byte_keeps_whole_lines(tmp_path: Path, room: int) -> None:
+    import json
+
+    from virja.events import NoteOn
+
+    path = tmp_path / "plan.jsonl"
+    raw = _FillingFile(str(path), "w")
+    raw.room = room
+    log = io.TextIOWrapper(io.BufferedWriter(raw, buffer_size=128), encoding="utf-8")
+    perf = Performance(router=Router(), planner=OnlinePlanner(), plan_log=log)
+    for i in range(20):
+        perf.feed(NoteOn(1.0 + i * 0.25, 9, 38, 90), now_s=0.0)
+        perf.advance(0.8 + i * 0.25)
+    planned = perf.finish()
+    assert len(perf.planner.report.dropped) + len(planned) <= 20
+    text = path.read_bytes()
+    assert text == b"" or text.endswith(b"\n")
+    for line in text.decode().splitlines():
+        json.loads(line)
+    assert (perf.plan_log_failed is None) == (len(text.splitlines()) == 20)

@@ -47,7 +47,7 @@ def test_dense_drum_flood_is_dropped_too_dense_and_planned_in_bounded_work() -> 
     counts = dict(planner.report.counts)
     assert counts["dropped_too_dense"] >= 400 - 2 * planner.bounds.max_notes * 2
     assert len(out) + counts["dropped"] == 400
-    assert all(p.limb in ("left_hand", "right_hand") for p in out)
+    assert {p.limb for p in out} <= {"left_hand", "right_hand", "left_foot"}  # hi-hat chicks
 
 
 def test_pending_notes_are_capped_planner_full() -> None:

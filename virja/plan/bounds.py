@@ -41,7 +41,7 @@ class PlanBounds:
     max_notes: int = 32  # per chain within span_s either side of a note
     max_pending: int = 1024  # notes waiting per chain
     window_groups: int = 16  # groups per solve
-    beam: int = 64  # states per DP layer (drums' hands; real drumming needs 45)
+    beam: int = 64  # states per DP layer (drums' hands; real drumming needs 25-45)
 
     def __post_init__(self) -> None:
         if not self.span_s > 0 or min(self.max_notes, self.max_pending) < 1:

@@ -82,3 +82,71 @@ def test_short_or_constant_series_raise_value_error() -> None:
         ar.fit_ar(np.ones(100))
     with pytest.raises(ValueError):
         ar.fit_ar(np.arange(5.0))
+
+
+def test_pacf_likelihood_equals_the_kalman_likelihood() -> None:
+    y = _simulate([0.5, -0.3, 0.2], 300, seed=1)
+    y = (y - y.mean()) / y.std()
+    u = np.array([0.3, -0.2, 0.5])
+    ll_k, s2_k = ar.concentrated_loglik(y, ar.pacf_to_ar(np.tanh(u)))
+    ll_p, s2_p = ar.concentrated_loglik_pacf(y, u)
+    assert ll_p == pytest.approx(ll_k, rel=1e-12)
+    assert s2_p == pytest.approx(s2_k, rel=1e-12)
+
+
+def test_pacf_likelihood_is_finite_at_the_unit_root_where_lyapunov_is_singular() -> None:
+    y = np.cumsum(np.random.default_rng(0).standard_normal(200))
+    ll, s2 = ar.concentrated_loglik_pacf(y / y.std(), np.array([30.0, 0.0, 0.0]))  # r1 == 1.0
+    assert np.isfinite(ll) and np.isfinite(s2)
+
+
+NEAR_UNIT_ROOT = {
+    "ar1 0.999": [0.999, 0.0, 0.0],
+    "triple root 0.99": [2.97, -2.9403, 0.970299],
+    "oscillating 0.995": [0.0, 0.0, 0.985],
+}
+
+
+@pytest.mark.parametrize(
+    "a",
+    [[0.5, -0.3, 0.2], [1.2, -0.6, 0.1], [2.1, -1.6, 0.45], *NEAR_UNIT_ROOT.values()],
+    ids=["plain", "smooth", "resonant", *NEAR_UNIT_ROOT],
+)
+def test_ml_fit_matches_or_beats_statsmodels(a: list[float]) -> None:
+    """Exact ML by statsmodels' state-space ARIMA: our log-likelihood is never lower."""
+    sm_arima = pytest.importorskip("statsmodels.tsa.arima.model")
+    import warnings
+
+    y = _simulate(a, 1500, seed=7)
+    y = y - y.mean()
+    fit = ar.fit_ar(y, demean=False)
+    assert np.isfinite(fit.loglik)
+    assert np.all(np.isfinite(ar.ar_to_pacf(fit.coefs)))  # stationary
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = sm_arima.ARIMA(y, order=(3, 0, 0), trend="n").fit()
+    assert fit.loglik >= ref.llf - 1e-6 * abs(ref.llf)
+    if fit.loglik - ref.llf < 1e-3:  # both at the same optimum: same coefficients
+        np.testing.assert_allclose(fit.coefs, ref.params[:3], atol=2e-3)
+    # our reported log-likelihood is the exact one at our estimate
+    assert ar.loglik(y, fit.coefs, fit.sigma2) == pytest.approx(fit.loglik, rel=1e-8)
+
+
+def test_random_walk_is_fitted_not_crashed() -> None:
+    y = np.cumsum(np.random.default_rng(2).standard_normal(3000))
+    fit = ar.fit_ar(y)
+    assert np.isfinite(fit.loglik)
+    assert abs(float(np.sum(fit.coefs)) - 1.0) < 0.05
+
+
+@pytest.mark.parametrize(
+    "y, words",
+    [
+        (np.ones(50), "constant"),
+        (np.array([0.0, 1.0, np.nan, 2.0, 1.0, 0.0, 1.0, 2.0]), "NaN"),
+        (np.arange(4.0), "at least 7"),
+    ],
+)
+def test_unfittable_series_raise_a_clear_error(y: np.ndarray, words: str) -> None:
+    with pytest.raises(ar.ARFitError, match=words):
+        ar.fit_ar(y)

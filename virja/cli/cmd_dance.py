@@ -48,11 +48,7 @@ def run(args: argparse.Namespace) -> int:
     audio = read_audio_8k(args.music)
     g = generate(db, audio)
     write_bvh(g.bvh, args.out)
-    exact = sum(1 for iv in g.intervals if iv.tolerance == 0)
-    print(
-        f"{args.out}: {g.bvh.n_frames} frames, {len(g.beats_s)} beats, "
-        f"{len(g.intervals)} segments ({exact} exact lengths)"
-    )
+    print(f"{args.out}: {g.bvh.n_frames} frames, {len(g.beats_s)} beats, {g.summary()}")
     if args.render:
         render(args, g.bvh, len(audio) / 8000.0)
     return 0

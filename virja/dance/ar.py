@@ -22,10 +22,14 @@ the plain recursion over every sample.
 
 sigma^2 is concentrated out (its ML value ``mean(e^2 / d)`` with d computed
 for sigma^2 = 1), leaving an m-dimensional problem.  Stationarity is built in:
-the optimiser works on unconstrained ``u``, partial autocorrelations are
-``tanh(u)`` in (-1, 1) and the Durbin-Levinson recursion turns them into
-``a`` (Jones 1980), so every trial point is a stationary AR.  The maximiser is
-BFGS (scipy), started from Yule-Walker.
+the optimiser works on ``u``, partial autocorrelations are ``tanh(u)`` in
+(-1, 1) and the Durbin-Levinson recursion turns them into ``a`` (Jones
+1980), so every trial point is a stationary AR.  The fit evaluates the same
+exact likelihood through the partial autocorrelations
+(:func:`concentrated_loglik_pacf`: no Lyapunov solve, finite up to the unit
+root), returns +inf where it cannot, and keeps the best of several
+starts of a bounded quasi-Newton method (L-BFGS-B); a series that cannot be
+fitted raises :class:`ARFitError` (callers report it, never zero it).
 """
 
 from __future__ import annotations
@@ -186,42 +190,118 @@ def yule_walker(y: FloatArray, m: int = AR_ORDER) -> FloatArray:
     return np.asarray(np.linalg.solve(R, c[1 : m + 1]), dtype=np.float64)
 
 
-def fit_ar(y: FloatArray, m: int = AR_ORDER, demean: bool = True) -> ARFit:
-    """Maximum-likelihood AR(m) fit of ``y`` (BFGS over tanh-parameterised PACF).
+class ARFitError(ValueError):
+    """A series cannot be fitted (too short, constant, not finite, or no start converges)."""
 
+
+def log_one_minus_tanh2(u: FloatArray) -> FloatArray:
+    """``log(1 - tanh(u)^2) = -2 log cosh u``, finite for every finite ``u``."""
+    u = np.abs(np.asarray(u, dtype=np.float64))
+    return np.asarray(2.0 * np.log(2.0) - 2.0 * u - 2.0 * np.log1p(np.exp(-2.0 * u)))
+
+
+def concentrated_loglik_pacf(y: FloatArray, u: FloatArray) -> tuple[float, float]:
+    """(max over sigma^2 of l, sigma^2) for partial autocorrelations ``tanh(u)``.
+
+    The same exact likelihood as :func:`concentrated_loglik`, with the first
+    m prediction variances from the Durbin-Levinson recursion instead of a
+    Lyapunov solve: ``d_n = sigma^2 / prod_(j > n) (1 - r_j^2)`` and
+    ``y_(n|n-1)`` by the order-n coefficients.  ``log(1 - r^2)`` is taken in
+    ``u`` (:func:`log_one_minus_tanh2`), so it stays finite as |r| -> 1 where
+    the Lyapunov equation becomes singular.
+    """
+    y = np.asarray(y, dtype=np.float64)
+    u = np.asarray(u, dtype=np.float64)
+    m, N = u.size, y.size
+    r = np.tanh(u)
+    l1r = log_one_minus_tanh2(u)
+    e = np.empty(N)
+    logd = np.zeros(N)  # log d_n for sigma^2 = 1
+    for n in range(min(m, N)):
+        phi = pacf_to_ar(r[:n])
+        e[n] = y[n] - float(np.dot(phi, y[n - 1 :: -1][:n])) if n > 0 else y[0]
+        logd[n] = -float(np.sum(l1r[n:]))
+    if m < N:
+        a = pacf_to_ar(r)
+        pred = np.zeros(N - m)
+        for j in range(1, m + 1):
+            pred += a[j - 1] * y[m - j : N - j]
+        e[m:] = y[m:] - pred
+    s2 = float(np.mean(e**2 * np.exp(-logd)))
+    if not np.isfinite(s2) or s2 <= 0.0:
+        return float("-inf"), float("nan")
+    ll = -0.5 * N * (np.log(2 * np.pi) + 1.0 + np.log(s2)) - 0.5 * float(np.sum(logd))
+    return float(ll), s2
+
+
+U_BOUND = 12.0
+"""|u| <= 12: |r| <= 1 - 7.6e-11, a root modulus within 1e-10 of the unit circle at most."""
+
+N_RANDOM_STARTS = 3
+
+
+def fit_ar(y: FloatArray, m: int = AR_ORDER, demean: bool = True, seed: int = 0) -> ARFit:
+    """Maximum-likelihood AR(m) fit of ``y`` (quasi-Newton over tanh-parameterised PACF).
+
+    Robustness: the objective is the exact likelihood in the partial
+    autocorrelations ``r = tanh(u)`` (never at the unit root; :func:`concentrated_loglik_pacf`),
+    it returns +inf where it cannot be evaluated, and the bounded quasi-Newton
+    (L-BFGS-B, ``|u| <= U_BOUND``) starts from Yule-Walker, from white noise
+    and from ``N_RANDOM_STARTS`` seeded random points; the best start wins.
     ``demean`` subtracts the mean first (the model has no constant).  A series
-    shorter than ``2 m + 1`` samples or constant raises ValueError.
+    that cannot be fitted (shorter than ``2 m + 1``, constant, not finite, no
+    start with a finite likelihood) raises :class:`ARFitError`.
     """
     y = np.asarray(y, dtype=np.float64)
     if y.ndim != 1 or y.size < 2 * m + 1:
-        raise ValueError(
+        raise ARFitError(
             f"AR({m}) needs a 1-D series of at least {2 * m + 1} samples, got {y.shape}"
         )
+    if not np.all(np.isfinite(y)):
+        raise ARFitError("AR fit of a series with NaN or infinite samples")
     if demean:
         y = y - y.mean()
     scale = float(np.std(y))
     if not np.isfinite(scale) or scale == 0.0:
-        raise ValueError("AR fit of a constant series is undefined")
+        raise ARFitError("AR fit of a constant series is undefined")
     y = y / scale  # the likelihood's maximiser in a does not depend on scale
 
-    r0 = np.clip(ar_to_pacf(yule_walker(y, m)), -0.99, 0.99)
-    r0 = np.nan_to_num(r0)
-    u0 = np.arctanh(r0)
-
     def objective(u: FloatArray) -> float:
-        ll, _ = concentrated_loglik(y, pacf_to_ar(np.tanh(u)))
-        return -ll / y.size
+        try:
+            with np.errstate(all="ignore"):
+                ll, _ = concentrated_loglik_pacf(y, u)
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError):
+            return float("inf")
+        return -ll / y.size if np.isfinite(ll) else float("inf")
 
-    res = minimize(objective, u0, method="BFGS", options={"gtol": 1e-7, "maxiter": 200})
-    a = pacf_to_ar(np.tanh(res.x))
-    ll, s2 = concentrated_loglik(y, a)
+    r_yw = np.nan_to_num(np.clip(ar_to_pacf(yule_walker(y, m)), -0.999, 0.999))
+    rng = np.random.default_rng(seed)
+    starts = [np.arctanh(r_yw), np.zeros(m), *rng.uniform(-1.5, 1.5, (N_RANDOM_STARTS, m))]
+    bounds = [(-U_BOUND, U_BOUND)] * m
+    best_u: FloatArray | None = None
+    best_f = float("inf")
+    n_iter = 0
+    converged = False
+    for u0 in starts:
+        if not np.isfinite(objective(u0)):
+            continue
+        res = minimize(
+            objective, u0, method="L-BFGS-B", bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-9}
+        )
+        n_iter += int(res.nit)
+        if np.isfinite(res.fun) and res.fun < best_f - 1e-12:
+            best_u, best_f, converged = np.asarray(res.x), float(res.fun), bool(res.success)
+    if best_u is None:
+        raise ARFitError(f"AR({m}) fit failed: the likelihood is not finite at any start")
+    a = pacf_to_ar(np.tanh(best_u))
+    ll, s2 = concentrated_loglik_pacf(y, best_u)
     # Back to the original scale: sigma^2 scales by scale^2, l by -N log(scale).
     return ARFit(
         coefs=a,
         sigma2=s2 * scale**2,
         loglik=float(ll - y.size * np.log(scale)),
-        n_iter=int(res.nit),
-        converged=bool(res.success),
+        n_iter=n_iter,
+        converged=converged,
     )
 
 

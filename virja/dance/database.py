@@ -16,14 +16,15 @@ Readers refuse other formats and newer versions with a clear error.
 from __future__ import annotations
 
 import json
+import logging
 import zipfile
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from virja.dance.ar import AR_ORDER, sound_parameters
+from virja.dance.ar import AR_ORDER, ARFitError, sound_parameters
 from virja.dance.audio import ANALYSIS_RATE_HZ, FloatArray
 from virja.dance.beats import extract_beats
 from virja.dance.segment import (
@@ -36,8 +37,14 @@ from virja.dance.segment import (
 from virja.errors import InputFileError, VirjaError
 from virja.motion.bvh import Bvh, BvhJoint
 
+log = logging.getLogger(__name__)
+
 FORMAT = "virja-dance-db"
 VERSION = 1
+
+MIN_SPAN = 5
+"""Shortest motion segment ``teach`` keeps, in frames: the paper's shortest (5 at 30 fps).
+A cut closer than this to the previous kept cut is dropped (the two pieces become one)."""
 
 
 class DanceError(VirjaError, ValueError):
@@ -65,6 +72,8 @@ class DanceDatabase:
     fps: float
     parts: str
     segments: tuple[Segment, ...]
+    notes: tuple[str, ...] = field(default=(), compare=False)
+    """What ``teach`` left out and why (not saved)."""
 
     @property
     def spans(self) -> list[int]:
@@ -84,12 +93,16 @@ def teach(
     q_over_r: float | None = DEFAULT_Q_OVER_R,
     source: str = "",
     audio_offset_s: float = 0.0,
+    min_span: int = MIN_SPAN,
 ) -> DanceDatabase:
     """Cut ``bvh`` at beats of its music and store each segment with its phrase's sound.
 
     ``audio_8k`` is the music at 8 kHz, starting ``audio_offset_s`` seconds
     after the capture's frame 0 (negative: before).  ``beats_s`` defaults to
-    the beats extracted from the audio (capture time).
+    the beats extracted from the audio (capture time).  Cuts closer than
+    ``min_span`` frames to the previous kept cut are dropped.  A segment whose
+    phrase cannot be fitted (silent, too short) is left out and said in
+    ``notes`` (and logged as a warning).
     """
     fps = 1.0 / bvh.frame_time_s
     audio = np.asarray(audio_8k, dtype=np.float64)
@@ -101,26 +114,40 @@ def teach(
         raise DanceError(
             f"no joint of the capture matches --parts {parts} (joint names: {bvh.names})"
         )
-    cuts, _ = segment_motion(bvh.rotations, fps, beats_s, weights, tolerance_frames, q_over_r)
+    all_cuts, _ = segment_motion(
+        bvh.rotations, fps, beats_s, weights, tolerance_frames, q_over_r
+    )
+    cuts = []
+    for c in all_cuts:
+        if not cuts or c.frame - cuts[-1].frame >= max(min_span, 1):
+            cuts.append(c)
     segments: list[Segment] = []
+    notes: list[str] = []
     for c0, c1 in zip(cuts[:-1], cuts[1:], strict=True):
         span = c1.frame - c0.frame
         lo = int(round((c0.beat_s - audio_offset_s) * ANALYSIS_RATE_HZ))
         hi = int(round((c1.beat_s - audio_offset_s) * ANALYSIS_RATE_HZ))
         phrase = audio[max(lo, 0) : max(hi, 0)]
-        if span <= 0 or phrase.size < 4 * AR_ORDER or np.std(phrase) == 0:
+        try:
+            if phrase.size < 4 * AR_ORDER:
+                raise ARFitError(f"{phrase.size} samples of music")
+            sound = sound_parameters(phrase)
+        except ARFitError as exc:
+            note = f"frames {c0.frame}-{c1.frame} left out: phrase not fitted ({exc})"
+            log.warning("%s: %s", source or "capture", note)
+            notes.append(note)
             continue
         segments.append(
             Segment(
                 rotations=bvh.rotations[c0.frame : c1.frame + 1].copy(),
                 root_positions=bvh.positions[c0.frame : c1.frame + 1, root].copy(),
-                sound=sound_parameters(phrase),
+                sound=sound,
                 span=span,
                 source=source,
                 start_frame=c0.frame,
             )
         )
-    return DanceDatabase(tuple(bvh.joints), fps, parts, tuple(segments))
+    return DanceDatabase(tuple(bvh.joints), fps, parts, tuple(segments), tuple(notes))
 
 
 def merge(databases: Sequence[DanceDatabase]) -> DanceDatabase:

@@ -24,13 +24,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--k",
         type=finite_float,
         default=BeatParams().k_mad,
-        help="threshold: median + K robust deviations (default 4)",
+        help="threshold: local median + K robust deviations (default 1.5)",
+    )
+    parser.add_argument(
+        "--no-periodicity",
+        action="store_true",
+        help="the paper's rule alone: no beats filled in on the beat period",
     )
 
 
 def run(args: argparse.Namespace) -> int:
     x = read_audio_8k(args.audio)
-    beats = [round(float(b), 4) for b in extract_beats(x, BeatParams(k_mad=args.k))]
+    beats = [round(float(b), 4) for b in extract_beats(x, BeatParams(k_mad=args.k, periodicity=not args.no_periodicity))]
     if args.json:
         print(json.dumps({"beats": beats}))
     else:

@@ -6,6 +6,10 @@ MUSIC (any audio libsndfile reads; beats extracted as by `virja beats`);
 each segment is stored with the AR(3) sound parameters of its music
 phrase.  The capture and the music must start together.  The database is a
 folder (manifest.json + segments.npz, docs/dance.md).
+
+A capture of another skeleton (CMU, Mixamo, MotionBuilder naming; any
+units, any rest pose) is first retargeted to virja's figure, so that the
+dancer is drawn like the band; --keep-skeleton keeps the capture's own.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from pathlib import Path
 from virja.cli.common import finite_float
 from virja.dance.audio import read_audio_8k
 from virja.dance.database import DanceError, load_database, merge, save_database, teach
+from virja.dance.retarget import find_landmarks, is_figure_skeleton, retarget_to_figure
 from virja.dance.segment import DEFAULT_TOLERANCE_FRAMES, PARTS
 from virja.motion.bvh import read_bvh
 
@@ -35,10 +40,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="how far a beat may be from a minimum of acceleration (default 3 frames)",
     )
     parser.add_argument("--append", action="store_true", help="add to the segments already in DB")
+    parser.add_argument(
+        "--keep-skeleton",
+        action="store_true",
+        help="teach on the capture's own skeleton (default: retarget to virja's figure)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     bvh = read_bvh(args.capture)
+    if not args.keep_skeleton and not is_figure_skeleton(bvh):
+        lm = find_landmarks(bvh.names)
+        bvh = retarget_to_figure(bvh)
+        print(f"{args.capture}: retargeted to the figure ({lm.style} naming)")
     audio = read_audio_8k(args.music)
     db = teach(
         bvh, audio, args.parts, tolerance_frames=args.tolerance, source=Path(args.capture).name

@@ -4,8 +4,10 @@
 places the motion on the stage: its first frame's waist goes to ``place``
 (x, z; default front centre, ahead of the drummer and the bassist), turned
 about the vertical so that its first frame faces the audience (+z), and
-lifted so that its lowest joint at frame 0 rests on the floor (y = its bone
-radius).  ``pose(t)`` interpolates joint positions linearly between the two
+every frame is lifted or lowered so that its lowest joint rests on the
+floor (y = its bone radius; ``ground="frame"``: the dancer stands on the
+floor whatever the waist height drift of the joins; ``ground="first"``
+lifts all frames by frame 0's amount only).  ``pose(t)`` interpolates joint positions linearly between the two
 nearest frames (rotations: the nearer frame) and clamps outside the motion.
 Frame 0 is at session time ``t0_s`` (for a MIDI file the audio starts at
 session time 0, so a dance generated from the session's audio has
@@ -27,8 +29,9 @@ from virja.motion.bvh import world_pose as bvh_world_pose
 from virja.motion.pose import FigurePose
 from virja.motion.skeleton import SKELETON
 
-DANCER_PLACE_XZ = (0.0, 0.9)
-"""Front centre: between the drummer (x -0.9) and the bassist (x 0.9), 0.9 m ahead of them."""
+DANCER_PLACE_XZ = (0.0, 1.5)
+"""Front centre: between the drummer (x -0.9) and the bassist (x 0.9), 1.5 m ahead of them,
+clear of the kit (its front edge is about 0.6 m ahead of the drummer) and the bass."""
 
 DEFAULT_RADIUS_M = 0.04
 """Bone radius for joints the project skeleton does not name."""
@@ -59,7 +62,10 @@ class DancerTrack:
         t0_s: float = 0.0,
         place_xz: tuple[float, float] = DANCER_PLACE_XZ,
         face_audience: bool = True,
+        ground: str = "frame",
     ) -> None:
+        if ground not in ("frame", "first"):
+            raise ValueError(f"ground must be 'frame' or 'first', got {ground!r}")
         if bvh.n_frames < 1:
             raise ValueError("the dance has no frames")
         pos, rot = world_pose(bvh)
@@ -74,9 +80,11 @@ class DancerTrack:
         self.names = tuple(bvh.names)
         self.parents = bvh.parents
         self.radii = _radii(self.names)
-        lift = float(np.min(pos[0, :, 1] - self.radii))
-        shift = np.array([place_xz[0] - start[0], -lift, place_xz[1] - start[2]])
+        lowest = np.min(pos[:, :, 1] - self.radii[None, :], axis=1)  # (n,)
+        lift = lowest if ground == "frame" else np.full(lowest.shape, lowest[0])
+        shift = np.array([place_xz[0] - start[0], 0.0, place_xz[1] - start[2]])
         self.positions: FloatArray = pos + shift
+        self.positions[:, :, 1] -= lift[:, None]
         self.rotations: FloatArray = rot
         self.fps = 1.0 / bvh.frame_time_s
         self.t0_s = float(t0_s)

@@ -11,6 +11,7 @@ import pytest
 import soundfile
 
 from virja.dance.audio import read_audio, read_audio_8k, to_mono, to_rate
+from virja.dance.beat_score import beat_score
 from virja.dance.beats import (
     BeatParams,
     adaptive_threshold,
@@ -20,7 +21,6 @@ from virja.dance.beats import (
     periodic_beats,
     suppress_neighbours,
 )
-from virja.dance.beat_score import beat_score
 from virja.dance.jazz_set import JazzClip, build_set
 from virja.dance.synth_music import music, thumps
 from virja.errors import InputFileError

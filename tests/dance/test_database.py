@@ -115,3 +115,21 @@ def test_capture_without_leg_joints_is_refused(bounce: Teacher, bounce_music: np
     bvh = Bvh(joints, bounce.bvh.frame_time_s, bounce.bvh.rotations, bounce.bvh.positions)
     with pytest.raises(DanceError, match="no joint"):
         teach(bvh, bounce_music, "legs", beats_s=bounce.beats_s)
+
+
+def test_segments_shorter_than_the_minimum_span_are_merged(
+    bounce: Teacher, bounce_music: np.ndarray
+) -> None:
+    db = teach(bounce.bvh, bounce_music, "legs", beats_s=bounce.beats_s, q_over_r=None, min_span=20)
+    assert min(db.spans) >= 20
+    assert sum(db.spans) <= bounce.bvh.n_frames
+
+
+def test_a_silent_phrase_is_left_out_and_said(bounce: Teacher, bounce_music: np.ndarray) -> None:
+    x = bounce_music.copy()
+    b = bounce.beats_s
+    x[int(b[2] * 8000) : int(b[3] * 8000)] = 0.0
+    db = teach(bounce.bvh, x, "legs", beats_s=b, q_over_r=None)
+    assert len(db.notes) == 1 and "not fitted" in db.notes[0]
+    full = teach(bounce.bvh, bounce_music, "legs", beats_s=b, q_over_r=None)
+    assert len(db.segments) == len(full.segments) - 1

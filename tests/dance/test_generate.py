@@ -107,3 +107,53 @@ def test_generation_extracts_beats_when_not_given(bounce_db: DanceDatabase) -> N
     beats = _new_beats(5, 12)
     g = generate(bounce_db, music(beats, beats[-1] + 0.5, seed=5))
     assert len(g.beats_s) == len(beats)
+
+
+def test_choice_uses_standardised_sound_parameters() -> None:
+    """a_1 spreads over 10, a_2 over 0.1: a step of 0.1 in a_2 weighs as much as 10 in a_1."""
+    sounds = ([0.0, 0.0, 0.0], [10.0, 0.05, 0.0], [0.0, 0.1, 0.0], [10.0, 0.1, 0.0])
+    seg = [Segment(quat.identity((11, 1)), np.zeros((11, 3)), np.array(s), 10) for s in sounds]
+    db = DanceDatabase((), 30.0, "legs", tuple(seg))
+    iv = CorrectedInterval(0, 0, 10, 0)
+    # raw distance would pick segment 2 (0.1 away in a_2) over 1 (2 away in a_1)
+    assert choose_segment(db, iv, np.array([8.0, 0.1, 0.0])) == 3
+    assert choose_segment(db, iv, np.array([2.0, 0.1, 0.0])) == 2
+
+
+def test_join_window_is_never_shorter_than_ten_frames(bounce_db: DanceDatabase) -> None:
+    beats = _new_beats(2)
+    g = generate(bounce_db, music(beats, beats[-1] + 0.5, seed=1), beats_s=beats)
+    assert g.h == max(10, 2 * min(bounce_db.spans))
+    assert generate(bounce_db, music(beats, beats[-1] + 0.5, seed=1), beats_s=beats, h=4).h == 4
+
+
+def test_report_counts_distinct_segments_and_reuse(bounce_db: DanceDatabase) -> None:
+    beats = _new_beats(3, 30)
+    g = generate(bounce_db, music(beats, beats[-1] + 0.5, seed=1), beats_s=beats)
+    assert g.distinct == len(set(g.choices))
+    assert g.most_reused == max(g.choices.count(c) for c in g.choices)
+    assert 0.0 < g.interpolated_share <= 1.0
+    assert f"{g.distinct} distinct" in g.summary()
+
+
+def test_a_silent_phrase_is_reported_not_given_made_up_sound(
+    bounce_db: DanceDatabase, caplog: pytest.LogCaptureFixture
+) -> None:
+    beats = _new_beats(4)
+    x = music(beats, beats[-1] + 0.5, seed=1)
+    lo, hi = int(beats[3] * 8000), int(beats[5] * 8000)
+    x[lo - 4000 : hi + 4000] = 0.0  # silence around two beat intervals
+    g = generate(bounce_db, x, beats_s=beats)
+    assert g.unfitted
+    assert "not fitted" in caplog.text
+    assert "not fitted" in g.summary()
+
+
+def test_random_choice_control_keeps_lengths_but_not_sound(bounce_db: DanceDatabase) -> None:
+    beats = _new_beats(5, 30)
+    x = music(beats, beats[-1] + 0.5, seed=1)
+    g = generate(bounce_db, x, beats_s=beats)
+    r = generate(bounce_db, x, beats_s=beats, random_choice=np.random.default_rng(0))
+    assert r.intervals == g.intervals
+    for iv, k in zip(r.intervals, r.choices, strict=True):
+        assert abs(bounce_db.segments[k].span - iv.span) <= iv.tolerance

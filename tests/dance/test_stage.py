@@ -44,3 +44,22 @@ def test_pose_interpolates_between_frames_and_clamps_outside() -> None:
     assert y(0.0) == y(1.0)  # before frame 0: held
     assert y(100.0) == y(2.0)  # after the last frame (1 s long): held
     assert y(1.5) == pytest.approx((y(1.0) + y(2.0)) / 2, abs=1e-9)  # halfway: linear
+
+
+def test_every_frame_stands_on_the_floor() -> None:
+    """The waist rises 10 cm over the dance (join drift): the feet stay on the floor."""
+    track = DancerTrack(turning_dance())
+    for t in (0.0, 0.5, 1.0):
+        fig = track.pose(t)
+        assert float(np.min(fig.positions[:, 1] - fig.radii)) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_the_dancer_stands_clear_of_the_kit_and_the_bass() -> None:
+    from virja.geometry import GEOMETRY
+
+    track = DancerTrack(turning_dance())
+    kit_front = max(float(d.centre[2]) + d.depth / 2 for d in GEOMETRY.kit.pieces.values())
+    assert float(track.positions[:, :, 2].min()) > kit_front + 0.2
+    bassist = GEOMETRY.stage.bassist_origin
+    gap = np.linalg.norm(track.positions[:, :, [0, 2]] - bassist[[0, 2]], axis=-1)
+    assert float(gap.min()) > 0.8

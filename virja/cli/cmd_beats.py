@@ -35,7 +35,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     x = read_audio_8k(args.audio)
-    beats = [round(float(b), 4) for b in extract_beats(x, BeatParams(k_mad=args.k, periodicity=not args.no_periodicity))]
+    beats = [
+        round(float(b), 4)
+        for b in extract_beats(x, BeatParams(k_mad=args.k, periodicity=not args.no_periodicity))
+    ]
     if args.json:
         print(json.dumps({"beats": beats}))
     else:

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.ndimage import maximum_filter, median_filter
 from scipy.fft import next_fast_len
+from scipy.ndimage import maximum_filter, median_filter
 from scipy.signal import butter, hilbert, sosfiltfilt
 
 from virja.dance.audio import ANALYSIS_RATE_HZ, FloatArray

@@ -131,10 +131,12 @@ def as_capture(fig_bvh: Bvh, style: str) -> Bvh:
     X: list[FloatArray] = []  # rest world position (m)
     C: list[FloatArray] = []  # rest correction
     Wt: list[FloatArray] = []  # world rotation over time
-    for name, parent, fig in specs:
+    for _name, parent, fig in specs:
         if isinstance(fig, tuple):
             p, c, frac = fig
-            X.append(rest[SKELETON.index(p)] + frac * (rest[SKELETON.index(c)] - rest[SKELETON.index(p)]))
+            X.append(
+                rest[SKELETON.index(p)] + frac * (rest[SKELETON.index(c)] - rest[SKELETON.index(p)])
+            )
             k = names.index(parent) if parent else 0
             C.append(C[k])
             Wt.append(Wt[k])
@@ -159,7 +161,7 @@ def as_capture(fig_bvh: Bvh, style: str) -> Bvh:
         end = None
         has_child = any(s[1] == name for s in specs)
         if not has_child:
-            fig_end = _END_OF.get(fig if isinstance(fig, str) else "", None)
+            fig_end = _END_OF.get(fig if isinstance(fig, str) else "")
             if isinstance(fig, tuple):  # a finger base: end at the hand's end
                 target = rest[SKELETON.index(fig[1])]
             elif fig_end is not None:

@@ -30,6 +30,7 @@ from virja.dance.beats import extract_beats
 from virja.dance.segment import (
     DEFAULT_Q_OVER_R,
     DEFAULT_TOLERANCE_FRAMES,
+    CutPoint,
     Parts,
     part_weights,
     segment_motion,
@@ -114,10 +115,8 @@ def teach(
         raise DanceError(
             f"no joint of the capture matches --parts {parts} (joint names: {bvh.names})"
         )
-    all_cuts, _ = segment_motion(
-        bvh.rotations, fps, beats_s, weights, tolerance_frames, q_over_r
-    )
-    cuts = []
+    all_cuts, _ = segment_motion(bvh.rotations, fps, beats_s, weights, tolerance_frames, q_over_r)
+    cuts: list[CutPoint] = []
     for c in all_cuts:
         if not cuts or c.frame - cuts[-1].frame >= max(min_span, 1):
             cuts.append(c)

@@ -32,10 +32,9 @@ the database's skeleton.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
-
-import logging
 
 import numpy as np
 
@@ -169,8 +168,13 @@ def generate(
     audio_8k: FloatArray,
     beats_s: Sequence[float] | None = None,
     h: int | None = None,
+    random_choice: np.random.Generator | None = None,
 ) -> Generated:
-    """Motion for music ``audio_8k`` (mono, 8 kHz) from ``db``; ``beats_s`` default: extracted."""
+    """Motion for music ``audio_8k`` (mono, 8 kHz) from ``db``; ``beats_s`` default: extracted.
+
+    ``random_choice``: the evaluation's control -- each segment is drawn at
+    random among the length-matched candidates instead of by sound.
+    """
     if not db.segments:
         raise DanceError("the database has no segments")
     audio = np.asarray(audio_8k, dtype=np.float64)
@@ -197,7 +201,10 @@ def generate(
         hi = int(round(frames[iv.last + 1] / fps * ANALYSIS_RATE_HZ))
         phrase = audio[lo:hi]
         try:
-            k = choose_segment(db, iv, sound_parameters(phrase), scale)
+            if random_choice is not None:
+                k = int(random_choice.choice(length_candidates(db, iv)))
+            else:
+                k = choose_segment(db, iv, sound_parameters(phrase), scale)
         except ARFitError as exc:  # reported, never a made-up sound
             log.warning(
                 "phrase %d (%.2f-%.2f s) not fitted (%s); segment chosen by length",

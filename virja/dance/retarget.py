@@ -168,7 +168,9 @@ def figure_joints() -> list[BvhJoint]:
             ch = ("Xposition", "Yposition", "Zposition", *ch)
         off = SKELETON.offsets[i]
         out.append(
-            BvhJoint(name, int(SKELETON.parents[i]), (float(off[0]), float(off[1]), float(off[2])), ch)
+            BvhJoint(
+                name, int(SKELETON.parents[i]), (float(off[0]), float(off[1]), float(off[2])), ch
+            )
         )
     return out
 

@@ -29,8 +29,8 @@ from virja.motion.bvh import world_pose as bvh_world_pose
 from virja.motion.pose import FigurePose
 from virja.motion.skeleton import SKELETON
 
-DANCER_PLACE_XZ = (0.0, 1.5)
-"""Front centre: between the drummer (x -0.9) and the bassist (x 0.9), 1.5 m ahead of them,
+DANCER_PLACE_XZ = (0.0, 1.1)
+"""Front centre: between the drummer (x -0.9) and the bassist (x 0.9), 1.1 m ahead of them,
 clear of the kit (its front edge is about 0.6 m ahead of the drummer) and the bass."""
 
 DEFAULT_RADIUS_M = 0.04

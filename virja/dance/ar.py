@@ -28,7 +28,7 @@ the optimiser works on ``u``, partial autocorrelations are ``tanh(u)`` in
 exact likelihood through the partial autocorrelations
 (:func:`concentrated_loglik_pacf`: no Lyapunov solve, finite up to the unit
 root), returns +inf where it cannot, and keeps the best of several
-starts of a bounded quasi-Newton method (L-BFGS-B); a series that cannot be
+starts of a quasi-Newton method (BFGS); a series that cannot be
 fitted raises :class:`ARFitError` (callers report it, never zero it).
 """
 
@@ -245,9 +245,10 @@ def fit_ar(y: FloatArray, m: int = AR_ORDER, demean: bool = True, seed: int = 0)
 
     Robustness: the objective is the exact likelihood in the partial
     autocorrelations ``r = tanh(u)`` (never at the unit root; :func:`concentrated_loglik_pacf`),
-    it returns +inf where it cannot be evaluated, and the bounded quasi-Newton
-    (L-BFGS-B, ``|u| <= U_BOUND``) starts from Yule-Walker, from white noise
-    and from ``N_RANDOM_STARTS`` seeded random points; the best start wins.
+    it returns +inf where it cannot be evaluated, and the quasi-Newton method
+    (BFGS, ``u`` clipped to ``|u| <= U_BOUND``) starts from Yule-Walker and from white
+    noise, and, when neither converges, from ``N_RANDOM_STARTS`` seeded random
+    points; the best start wins.
     ``demean`` subtracts the mean first (the model has no constant).  A series
     that cannot be fitted (shorter than ``2 m + 1``, constant, not finite, no
     start with a finite likelihood) raises :class:`ARFitError`.
@@ -267,6 +268,7 @@ def fit_ar(y: FloatArray, m: int = AR_ORDER, demean: bool = True, seed: int = 0)
     y = y / scale  # the likelihood's maximiser in a does not depend on scale
 
     def objective(u: FloatArray) -> float:
+        u = np.clip(u, -U_BOUND, U_BOUND)
         try:
             with np.errstate(all="ignore"):
                 ll, _ = concentrated_loglik_pacf(y, u)
@@ -277,22 +279,23 @@ def fit_ar(y: FloatArray, m: int = AR_ORDER, demean: bool = True, seed: int = 0)
     r_yw = np.nan_to_num(np.clip(ar_to_pacf(yule_walker(y, m)), -0.999, 0.999))
     rng = np.random.default_rng(seed)
     starts = [np.arctanh(r_yw), np.zeros(m), *rng.uniform(-1.5, 1.5, (N_RANDOM_STARTS, m))]
-    bounds = [(-U_BOUND, U_BOUND)] * m
     best_u: FloatArray | None = None
     best_f = float("inf")
     n_iter = 0
     converged = False
-    for u0 in starts:
+    for k, u0 in enumerate(starts):
+        if k >= 2 and converged:  # random restarts only when neither fixed start converged
+            break
         if not np.isfinite(objective(u0)):
             continue
-        res = minimize(
-            objective, u0, method="L-BFGS-B", bounds=bounds, options={"ftol": 1e-15, "gtol": 1e-9}
-        )
+        res = minimize(objective, u0, method="BFGS", options={"gtol": 1e-6, "maxiter": 200})
         n_iter += int(res.nit)
         if np.isfinite(res.fun) and res.fun < best_f - 1e-12:
-            best_u, best_f, converged = np.asarray(res.x), float(res.fun), bool(res.success)
+            best_u, best_f = np.asarray(res.x), float(res.fun)
+            converged = bool(res.success) or res.status == 2  # 2: precision lost at the optimum
     if best_u is None:
         raise ARFitError(f"AR({m}) fit failed: the likelihood is not finite at any start")
+    best_u = np.clip(best_u, -U_BOUND, U_BOUND)
     a = pacf_to_ar(np.tanh(best_u))
     ll, s2 = concentrated_loglik_pacf(y, best_u)
     # Back to the original scale: sigma^2 scales by scale^2, l by -N log(scale).

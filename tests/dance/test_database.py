@@ -126,10 +126,12 @@ def test_segments_shorter_than_the_minimum_span_are_merged(
 
 
 def test_a_silent_phrase_is_left_out_and_said(bounce: Teacher, bounce_music: np.ndarray) -> None:
-    x = bounce_music.copy()
     b = bounce.beats_s
-    x[int(b[2] * 8000) : int(b[3] * 8000)] = 0.0
+    full = teach(bounce.bvh, bounce_music, "legs", beats_s=b, q_over_r=None)
+    seg = full.segments[2]
+    x = bounce_music.copy()
+    t0, t1 = seg.start_frame / 30, (seg.start_frame + seg.span) / 30
+    x[int(t0 * 8000) - 8 : int(t1 * 8000) + 8] = 0.0  # that phrase is silent
     db = teach(bounce.bvh, x, "legs", beats_s=b, q_over_r=None)
     assert len(db.notes) == 1 and "not fitted" in db.notes[0]
-    full = teach(bounce.bvh, bounce_music, "legs", beats_s=b, q_over_r=None)
     assert len(db.segments) == len(full.segments) - 1

@@ -58,7 +58,10 @@ def test_the_dancer_stands_clear_of_the_kit_and_the_bass() -> None:
     from virja.geometry import GEOMETRY
 
     track = DancerTrack(turning_dance())
-    kit_front = max(float(d.centre[2]) + d.depth / 2 for d in GEOMETRY.kit.pieces.values())
+    kit_front = max(  # the nearest point of any drum or cymbal to the audience
+        float(p.centre[2]) + max(float(getattr(p, "depth", 0.0)) / 2, float(p.radius))
+        for p in GEOMETRY.kit.pieces.values()
+    )
     assert float(track.positions[:, :, 2].min()) > kit_front + 0.2
     bassist = GEOMETRY.stage.bassist_origin
     gap = np.linalg.norm(track.positions[:, :, [0, 2]] - bassist[[0, 2]], axis=-1)

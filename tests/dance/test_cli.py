@@ -13,6 +13,7 @@ from virja.cli.main import main
 from virja.dance.synth_capture import Teacher
 from virja.dance.synth_music import music
 from virja.motion.bvh import read_bvh, write_bvh
+from virja.motion.skeleton import SKELETON
 
 
 @pytest.fixture()
@@ -53,19 +54,20 @@ def test_unreadable_audio_is_a_one_line_error(
     assert "x.wav" in err and "Traceback" not in err and err.count("\n") == 1
 
 
-def test_teach_then_dance_writes_a_bvh_on_the_teachers_skeleton(
-    files: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize("keep", [False, True])
+def test_teach_then_dance_writes_a_bvh_on_the_figure_or_the_teachers_skeleton(
+    files: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str], keep: bool
 ) -> None:
     db = tmp_path / "db"
-    assert (
-        main(["teach", str(files["cap"]), str(files["wav"]), "--parts", "legs", "--out", str(db)])
-        == 0
-    )
+    args = ["teach", str(files["cap"]), str(files["wav"]), "--parts", "legs", "--out", str(db)]
+    assert main(args + (["--keep-skeleton"] if keep else [])) == 0
     assert (db / "manifest.json").is_file()
+    assert ("retargeted" in capsys.readouterr().out) is not keep
     out = tmp_path / "out.bvh"
     assert main(["dance", str(files["new"]), "--db", str(db), "--out", str(out)]) == 0
     motion = read_bvh(out)
-    assert motion.names == read_bvh(files["cap"]).names
+    want = read_bvh(files["cap"]).names if keep else list(SKELETON.names)
+    assert motion.names == want
     assert motion.n_frames > 100
     assert "segments" in capsys.readouterr().out
 

@@ -264,7 +264,10 @@ def pulse_steadiness(times_s: FloatArray, period_s: float, slack: float = 0.2) -
 
 
 STEADY_SHARE = 0.6
-"""The periodicity stage runs only where this share of intervals fits the period."""
+"""The periodicity stage runs only where this share of intervals fits the period..."""
+
+MIN_PULSE_BEATS = 16
+"""...and on at least this many beats (four bars): on fewer, irregular beats fit by chance."""
 
 
 def periodic_beats(
@@ -272,9 +275,10 @@ def periodic_beats(
 ) -> FloatArray:
     """The periodicity stage (an extension, not in the paper).
 
-    Only for a steady pulse (:func:`pulse_steadiness` of the beats left
-    after dropping >= ``STEADY_SHARE``; otherwise the beats are returned
-    unchanged: music without a pulse keeps the paper's beats).
+    Only for a steady pulse (at least ``MIN_PULSE_BEATS`` beats and
+    :func:`pulse_steadiness` of the beats left after dropping >=
+    ``STEADY_SHARE``; otherwise the beats are returned unchanged: music
+    without a pulse keeps the paper's beats).
     With ``P`` = :func:`beat_period`: of two beats closer than ``close * P``
     the weaker is dropped (off-beat pickups, anticipations), then a gap of
     ``n * P`` (n >= 2, within ``slack * P``) between consecutive beats is
@@ -282,7 +286,7 @@ def periodic_beats(
     sound: a two-feel bass, a waltz's empty beats).
     """
     t = np.asarray(times_s, dtype=np.float64)
-    if t.size < 4:
+    if t.size < MIN_PULSE_BEATS:
         return t
     period = beat_period(t)
     if not np.isfinite(period):

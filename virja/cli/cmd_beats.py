@@ -2,7 +2,9 @@
 
 Reads AUDIO (WAV, FLAC or anything libsndfile reads), mixes to mono,
 resamples to 8 kHz and prints one beat time in seconds per line; with
---json one object {"beats": [...]}.  See docs/dance.md for the parameters.
+--json one object {"beats": [...]}.  Times are note onsets; a steady pulse
+gets the beats it did not sound filled in (periodicity stage, an extension;
+--no-periodicity for the paper's rule alone).  See docs/dance.md.
 """
 
 from __future__ import annotations

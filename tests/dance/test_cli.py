@@ -89,3 +89,28 @@ def test_dance_with_missing_database_is_a_one_line_error(
         == 1
     )
     assert "no manifest.json" in capsys.readouterr().err
+
+
+def test_beats_of_silence_says_so_and_fails(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    quiet = tmp_path / "silence.wav"
+    soundfile.write(str(quiet), np.zeros(8000 * 3, dtype=np.float32), 8000)
+    assert main(["beats", str(quiet)]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and "no beats found" in err and "--k" in err
+
+
+def test_teach_never_overwrites_a_database_unasked(
+    files: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    db = tmp_path / "db"
+    args = ["teach", str(files["cap"]), str(files["wav"]), "--parts", "legs", "--out", str(db)]
+    assert main(args) == 0
+    before = (db / "manifest.json").read_bytes()
+    capsys.readouterr()
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "exists" in err and "--append" in err and "--force" in err
+    assert (db / "manifest.json").read_bytes() == before
+    assert main([*args, "--force"]) == 0

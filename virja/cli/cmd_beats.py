@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from virja.cli.common import finite_float
-from virja.dance.audio import read_audio_8k
+from virja.dance.audio import ANALYSIS_RATE_HZ, read_audio_8k
 from virja.dance.beats import BeatParams, extract_beats
 
 
@@ -46,4 +47,13 @@ def run(args: argparse.Namespace) -> int:
     else:
         for b in beats:
             print(f"{b:.4f}")
+    if not beats:
+        # silence, or no pulse in the 30-120 Hz band: say so, and fail, rather than print nothing
+        print(
+            f"virja beats: no beats found in {args.audio} ({len(x) / ANALYSIS_RATE_HZ:.1f} s): no onsets in "
+            "the 30-120 Hz band stand out (silence, or music without a low pulse); "
+            "a lower --k finds weaker ones",
+            file=sys.stderr,
+        )
+        return 1
     return 0

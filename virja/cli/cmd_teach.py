@@ -40,6 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="how far a beat may be from a minimum of acceleration (default 3 frames)",
     )
     parser.add_argument("--append", action="store_true", help="add to the segments already in DB")
+    parser.add_argument("--force", action="store_true", help="replace an existing database DB")
     parser.add_argument(
         "--keep-skeleton",
         action="store_true",
@@ -53,6 +54,12 @@ def run(args: argparse.Namespace) -> int:
         lm = find_landmarks(bvh.names)
         bvh = retarget_to_figure(bvh)
         print(f"{args.capture}: retargeted to the figure ({lm.style} naming)")
+    out = Path(args.out)
+    if out.exists() and not args.append and not args.force:
+        raise DanceError(
+            f"{out} exists: give --append to add to that database, --force to replace it, "
+            "or another --out"
+        )
     audio = read_audio_8k(args.music)
     db = teach(
         bvh, audio, args.parts, tolerance_frames=args.tolerance, source=Path(args.capture).name

@@ -335,7 +335,13 @@ class OnlinePlanner:
     def _fix_bass(self, chain: _Chain, groups: list[list[_Rec]], n_groups: int) -> None:
         prepared = [self._bass_group(g) for g in groups]
         if chain.plan is None:
-            sol = bass_mod.solve(chain.state, [opts for _, opts in prepared])
+            times = [g[0].note.time_s for g in groups]
+            last = chain.last_fixed_t
+            gaps = [times[0] - last if last is not None else math.inf]
+            gaps += [b - a for a, b in zip(times, times[1:], strict=False)]
+            sol = bass_mod.solve(
+                chain.state, [opts for _, opts in prepared], self.config.bass.fingering, gaps
+            )
             chain.plan = list(zip(sol.choice, sol.costs, sol.states, strict=True))
         for gi in range(n_groups):
             kept, opts = prepared[gi]
@@ -667,8 +673,9 @@ class OnlinePlanner:
                 self._drop(rec, "no_double_stop")
             else:
                 opts = [(p,) for p in bass_mod.positions(self.config.bass, rec.played)]
-                best = min(opts, key=lambda o: bass_mod.transition(chain.state, o)[0])
-                cost = bass_mod.transition(chain.state, best)[0]
+                fingering = self.config.bass.fingering
+                best = min(opts, key=lambda o: bass_mod.transition(chain.state, o, fingering)[0])
+                cost = bass_mod.transition(chain.state, best, fingering)[0]
                 self._emit_bass_group(chain, [rec], [rec.played], best, cost)
             return
         assert rec.drum is not None

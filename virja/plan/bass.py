@@ -214,13 +214,48 @@ def solve(
     """
     best: dict[BassState, float] = {state: 0.0}
     backs: list[dict[BassState, tuple[BassState, int, float]]] = []
+    per = fingering.position_cost_per_fret
+    span = fingering.span
     for gi, options in enumerate(groups):
         gap = math.inf if gaps is None else gaps[gi]
+        # :func:`transitions` inlined, with what does not depend on the previous state
+        # worked out once per group (same arithmetic, same order, same results)
+        prepared = []
+        for opt in options:
+            a = anchor(opt)
+            if a is None:
+                prepared.append((a, opt[0][0], 0, 0, ()))
+                continue
+            low, high = _stops(opt) or (a[1], a[1])
+            prepared.append((a, opt[0][0], low, high, hand_positions(fingering, low, high)))
         nxt: dict[BassState, float] = {}
         back: dict[BassState, tuple[BassState, int, float]] = {}
         for prev, acc in best.items():
-            for k, opt in enumerate(options):
-                for c, new in transitions(prev, opt, fingering, gap):
+            for k, (a, melody, low, high, hs) in enumerate(prepared):
+                moves: list[tuple[float, BassState]]
+                if a is None:
+                    moves = [(0.0 if prev is None else float(abs(melody - prev[0])), prev)]
+                elif prev is None:
+                    moves = [(per * (h - 1), (a[0], a[1], h)) for h in hs]
+                else:
+                    s0, f0, h0 = prev
+                    base = float(abs(a[1] - f0) + abs(a[0] - s0))
+                    if h0 <= low and high <= h0 + span(h0):
+                        moves = [(base + per * (h0 - 1), (a[0], a[1], h0))]
+                    else:
+                        moves = []
+                        for h in hs:
+                            d = abs(h - h0)
+                            c = (
+                                base
+                                + fingering.shift_cost
+                                + fingering.shift_cost_per_fret * d
+                                + per * (h - 1)
+                            )
+                            if gap < fingering.shift_time(d):
+                                c += fingering.rushed_shift_cost
+                            moves.append((c, (a[0], a[1], h)))
+                for c, new in moves:
                     total = acc + c
                     old = nxt.get(new)
                     if old is None or total < old:

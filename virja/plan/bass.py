@@ -47,6 +47,19 @@ BassOption = tuple[Position, ...]  # one position per kept note, melody first
 DEFAULT_FINGERING = Fingering()
 
 
+def motion_name(string: str, fret: int, hand: BassState) -> str:
+    """The basic motion's name: ``pluck_<string>_fret<fret>``, and ``_pos<position>``
+    of the left hand once it has one (an open string keeps the hand where it was)."""
+    base = f"pluck_{string}_fret{fret}"
+    return base if hand is None else f"{base}_pos{hand[2]}"
+
+
+def position_of(motion: str) -> int | None:
+    """The hand position a bass motion name carries (None if it carries none)."""
+    _, sep, tail = motion.rpartition("_pos")
+    return int(tail) if sep and tail.isdigit() else None
+
+
 def fold_into_range(setup: BassSetup, note: int) -> int:
     """``note`` moved by whole octaves into the bass's range (unchanged if inside)."""
     while note < setup.lowest:

@@ -71,28 +71,21 @@ def fingering_table(
     for i, n in enumerate(notes):
         planner.add_note("bass", NoteOn(i * beats_each * spb, 0, n, 90), now_s=-1.0)
     planned = sorted(planner.flush(), key=lambda p: p.time)
-    # the hand states are the solver's: replay the chosen options through it
-    options = [(((cfg.bass.strings.index(_string(cfg, p.string)), p.fret or 0),)) for p in planned]
-    gaps = [float("inf")] + [b.time - a.time for a, b in zip(planned, planned[1:], strict=False)]
-    sol = bass_mod.solve(None, [[o] for o in options], cfg.bass.fingering, gaps)
     out: list[Fingered] = []
-    before: bass_mod.BassState = None
-    for p, state in zip(planned, sol.states, strict=True):
+    before: int | None = None
+    for p in planned:
+        pos = bass_mod.position_of(p.motion)
         out.append(
             Fingered(
                 p.note,
                 p.string or "",
                 p.fret or 0,
-                state[2] if state is not None else None,
-                bass_mod.shifted(before, state),
+                pos,
+                before is not None and pos != before,
             )
         )
-        before = state
+        before = pos
     return out
-
-
-def _string(cfg: PlanConfig, name: str | None) -> tuple[str, int]:
-    return next(s for s in cfg.bass.strings if s[0] == name)
 
 
 def markdown(title: str, rows: list[Fingered]) -> str:

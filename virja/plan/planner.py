@@ -346,7 +346,7 @@ class OnlinePlanner:
         for gi in range(n_groups):
             kept, opts = prepared[gi]
             choice, cost, state = chain.plan[gi]
-            self._emit_bass_group(chain, groups[gi], kept, opts[choice], cost)
+            self._emit_bass_group(chain, groups[gi], kept, opts[choice], cost, state)
             chain.state = state
 
     def _emit_bass_group(
@@ -356,6 +356,7 @@ class OnlinePlanner:
         kept: list[int],
         option: bass_mod.BassOption,
         cost: float,
+        hand: bass_mod.BassState,
     ) -> None:
         where = dict(zip(kept, option, strict=True))
         paid = False
@@ -372,7 +373,7 @@ class OnlinePlanner:
                 piece=None,
                 string=name,
                 fret=f,
-                motion=f"pluck_{name}_fret{f}",
+                motion=bass_mod.motion_name(name, f, hand),
                 cost=0.0 if paid else cost,
             )
             paid = True
@@ -675,8 +676,8 @@ class OnlinePlanner:
                 opts = [(p,) for p in bass_mod.positions(self.config.bass, rec.played)]
                 fingering = self.config.bass.fingering
                 best = min(opts, key=lambda o: bass_mod.transition(chain.state, o, fingering)[0])
-                cost = bass_mod.transition(chain.state, best, fingering)[0]
-                self._emit_bass_group(chain, [rec], [rec.played], best, cost)
+                cost, hand = bass_mod.transition(chain.state, best, fingering)
+                self._emit_bass_group(chain, [rec], [rec.played], best, cost, hand)
             return
         assert rec.drum is not None
         piece = rec.drum.piece

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from virja.geometry import BASS_STRINGS, GEOMETRY, Geometry
+from virja.geometry import ALL_BASS_STRINGS, GEOMETRY, Geometry
 from virja.motion import ik, quat
 from virja.motion.bvh import Bvh, BvhJoint, write_bvh
 from virja.motion.skeleton import (
@@ -500,7 +500,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
         "the drummer's ready pose: sticks over the snare, feet on the pedals",
     )
     count += 1
-    for s in BASS_STRINGS:
+    for s in ALL_BASS_STRINGS:  # the five- and six-string basses' B and C too
         for f in range(1, MAX_FRET + 1):
             loc, root, imp = fret_hold(geo, s, f)
             meta = {

@@ -22,7 +22,14 @@ from typing import Any, Protocol
 import numpy as np
 
 from virja.events import Beat
-from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, DRUM_PIECES, GEOMETRY, Geometry
+from virja.geometry import (
+    ALL_BASS_STRINGS,
+    BASS_STRINGS,
+    CYMBAL_PIECES,
+    DRUM_PIECES,
+    GEOMETRY,
+    Geometry,
+)
 from virja.motion import quat
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.pose import BandPose, FigurePose
@@ -167,6 +174,18 @@ class BandAnimator:
         pedal = geometry.kit.hihat_pedal
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
+        self.bass_strings: tuple[str, ...] = BASS_STRINGS
+
+    def use_bass_strings(self, strings: tuple[str, ...]) -> None:
+        """The strings of the bass's tuning, low to high (four by default; B E A D G for a
+        five-string, B E A D G C for a six-string): played, and shown in the pose."""
+        unknown = [s for s in strings if s not in ALL_BASS_STRINGS]
+        if unknown or not strings:
+            raise UnknownMotionError(
+                f"the bassist's clips cover the strings {' '.join(ALL_BASS_STRINGS)}; "
+                f"got {' '.join(strings) or 'none'}"
+            )
+        self.bass_strings = tuple(strings)
 
     # ------------------------------------------------------------------ input
 
@@ -214,11 +233,10 @@ class BandAnimator:
             )
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
         elif p.performer == "bass":
-            if p.string not in BASS_STRINGS:
+            if p.string not in self.bass_strings:
                 raise UnknownMotionError(
-                    f"the bassist's clips cover the strings {' '.join(BASS_STRINGS)}; a note "
-                    f"planned on the {p.string!r} string (a five-string or custom tuning in "
-                    "[plan]) can be planned with `virja plan` but not animated yet"
+                    f"a bass note planned on the {p.string!r} string; this bass has "
+                    f"{' '.join(self.bass_strings)} (the tuning in [plan] decides)"
                 )
             pluck = self.library[f"pluck_{p.string}"]
             self.timelines[("bass", "right_hand")].add(
@@ -433,7 +451,7 @@ class BandAnimator:
         return out
 
     def _strings(self, t: float) -> dict[str, float]:
-        out = dict.fromkeys(BASS_STRINGS, 0.0)
+        out = dict.fromkeys(self.bass_strings, 0.0)
         s = self.settings
         latest: dict[str, Hit] = {}
         for h in self._recent(t, 8 * s.string_decay_s):
@@ -446,7 +464,7 @@ class BandAnimator:
         return out
 
     def _stops(self, t: float) -> dict[str, int]:
-        out = dict.fromkeys(BASS_STRINGS, 0)
+        out = dict.fromkeys(self.bass_strings, 0)
         act = self.timelines[("bass", "left_hand")].active(t)
         for inst in reversed(act):
             if inst.impact <= t:

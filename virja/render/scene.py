@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
+from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import BandPose, FigurePose
 from virja.render.meshes import (
     box_transforms,
@@ -256,11 +256,15 @@ def _rotate(v: F64, axis: F64, angle: float) -> F64:
 
 
 def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) -> None:
-    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge."""
+    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge.
+
+    The strings drawn are the pose's (the tuning's: four, five or six)."""
     b = geo.bass
     lateral = np.cross(b.axis, b.front)
     lateral /= np.linalg.norm(lateral)
-    for k, s in enumerate(b.strings):
+    drawn = [s for s in b.strings if s in pose.string_vibration] or list(BASS_STRINGS)
+    for s in drawn:
+        k = b.strings.index(s) - b.strings.index("E")  # thinner from the E string up
         a, z = b.nut[s], b.bridge[s]
         amp = float(pose.string_vibration.get(s, 0.0))
         radius = 0.0022 - 0.0003 * k

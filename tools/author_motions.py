@@ -331,12 +331,38 @@ def finger_hand(
 
 
 LEFT_POLE = np.array([0.45, -0.35, -0.10])
+# the fretting hand comes round the neck from its E side (the player's left, where the
+# arm is): from the wrist to the fingertip mostly across the fingerboard toward the G
+# side, a little forward onto the string and down the neck; the thumb stays behind
+FRET_HAND_DIR = (-0.80, 0.30, -0.45)  # (lateral toward E, front, axis toward the scroll)
+
+
+def fret_hand(body: Body, geo: Geometry, tip: np.ndarray) -> bool:
+    """Pose the left arm with its fingertip at ``tip``, the hand round the neck's E side
+    (where the arm cannot reach so far round, high up the low strings, less far)."""
+    b = geo.bass
+    lateral = _unit(np.cross(b.axis, b.front))
+    lt, fr, ax = FRET_HAND_DIR
+    want = _unit(lt * lateral + fr * b.front + ax * b.axis)
+    shoulder = body.pos("LeftArm")
+    plain = _unit(_unit(tip - shoulder) - 0.8 * b.front)  # straight at the string
+    for w in (1.0, 0.8, 0.6, 0.4, 0.2, 0.0):
+        d = _unit(w * want + (1.0 - w) * plain)
+        hand = ik.aim(np.array([0.0, -1.0, 0]), np.array([1.0, 0, 0]), d, -b.front)
+        wrist = tip - quat.rotate(hand, HAND_END)
+        trial = body.copy()
+        if trial.arm("Left", wrist, hand, shoulder + LEFT_POLE):
+            body.local, body.wpos, body.wrot = trial.local, trial.wpos, trial.wrot
+            return True
+    return False
+
+
 RIGHT_POLE = np.array([-0.40, -0.40, -0.20])
 
 
 def bass_ready(body: Body, geo: Geometry) -> None:
     b = geo.bass
-    finger_hand(body, "Left", b.string_point("D", 5) + 0.04 * b.front, -b.front, LEFT_POLE)
+    fret_hand(body, geo, b.string_point("D", 5) + 0.02 * b.front)
     finger_hand(body, "Right", right_ready(geo), -b.front, RIGHT_POLE)
 
 
@@ -364,7 +390,7 @@ def fret_hold(geo: Geometry, string: str | None, fret: int) -> tuple[np.ndarray,
     out = []
     for t in _frames(0.12):
         body = base.copy()
-        if not finger_hand(body, "Left", path(t), -b.front, LEFT_POLE):
+        if not fret_hand(body, geo, path(t)):
             raise SystemExit(f"fret {string}{fret}: out of reach")
         out.append(body.local.copy())
     return np.array(out), base.root, impact

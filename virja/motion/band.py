@@ -31,6 +31,7 @@ from virja.geometry import (
     Geometry,
 )
 from virja.motion import quat
+from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
@@ -108,6 +109,7 @@ class AnimationSettings:
     hihat_travel_m: float = 0.04
     string_amp_m: float = 0.004
     string_decay_s: float = 1.2
+    bassist: BassistSettings = BassistSettings()
 
     @classmethod
     def load(cls, path: Path | None = None) -> AnimationSettings:
@@ -132,6 +134,7 @@ class AnimationSettings:
             hihat_travel_m=k["hihat_travel_m"],
             string_amp_m=d["strings"]["amplitude_m"],
             string_decay_s=d["strings"]["decay_s"],
+            bassist=BassistSettings.from_table(d.get("bassist", {})),
         )
 
 
@@ -175,6 +178,7 @@ class BandAnimator:
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
+        self.bassist = Bassist(geometry, self.settings.bassist)
 
     def use_bass_strings(self, strings: tuple[str, ...]) -> None:
         """The strings of the bass's tuning, low to high (four by default; B E A D G for a
@@ -259,8 +263,14 @@ class BandAnimator:
                 if current and current[-1].clip.string == p.string:
                     left.add(self._hold("fret_open", p))
             self._add_hit(Hit(p.impact, p.string, p.velocity))
+            self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity)
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
+
+    def note_off(self, performer: str, event: Any) -> None:
+        """A note-off: the bassist's fingers lift from the string (an open string rings on)."""
+        if performer == "bass":
+            self.bassist.note_off(int(event.note), float(event.time_s))
 
     def _hold(self, name: str, p: PlannedNoteLike) -> Instance:
         # a hold with no predecessor fades in from the rest pose over its preparation
@@ -278,6 +288,7 @@ class BandAnimator:
         for tl in self.timelines.values():
             tl.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
+        self.bassist.forget_before(horizon)
         k = bisect.bisect_left(self._hit_times, horizon)
         del self._hits[:k]
         del self._hit_times[:k]
@@ -301,7 +312,20 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
+        index, phase = self._beat_phase(time_s)
+        out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
+
+    def _beat_phase(self, t: float) -> tuple[int, float]:
+        """(beat number, phase 0..1 within it) at ``t`` (120 bpm before the first beat)."""
+        i = bisect.bisect_right(self._beat_times, t) - 1
+        if i >= 0:
+            phase = (t - self._beat_times[i]) / self._beat_spb[i]
+            if phase < 1.0:
+                return i, phase
+            return i + int(phase), phase % 1.0
+        spb = self.settings.reference_spb
+        return int(math.floor(t / spb)), (t / spb) % 1.0
 
     def _nod(self, t: float) -> np.ndarray:
         s = self.settings
@@ -339,6 +363,7 @@ class BandAnimator:
             string_stops=self._stops(time_s),
             fretting_tip=wpos[1, _SK.index("LeftHandEnd")].copy(),
             plucking_tip=wpos[1, _SK.index("RightHandEnd")].copy(),
+            bass_fingers=self.bassist.fingers(time_s, wpos[1]),
         )
 
     def local_rotations_many(self, times: np.ndarray) -> np.ndarray:

@@ -8,7 +8,7 @@ read-only by the consumer.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -53,7 +53,9 @@ class BandPose:
       metres at the middle of the vibrating part, decaying after a pluck;
     - ``string_stops``: string -> fret stopped now (0 = open);
     - ``fretting_tip``: (3,) the bassist's left (fretting) fingertip, metres;
-    - ``plucking_tip``: (3,) the bassist's right (plucking) fingertip, metres.
+    - ``plucking_tip``: (3,) the bassist's right (plucking) fingertip, metres;
+    - ``bass_fingers``: (k, 2, 3) the bassist's finger bones (from, to), metres
+      (:mod:`virja.motion.bassist`; empty when not drawn).
     """
 
     time_s: float
@@ -67,6 +69,7 @@ class BandPose:
     string_stops: Mapping[str, int]
     fretting_tip: np.ndarray
     plucking_tip: np.ndarray
+    bass_fingers: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
 
     def figure(self, performer: str) -> FigurePose:
         """``"drums"`` or ``"bass"``."""

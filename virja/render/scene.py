@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
+from virja.motion.bassist import LEFT_BONES
 from virja.motion.pose import BandPose, FigurePose
 from virja.render.meshes import (
     box_transforms,
@@ -168,7 +169,7 @@ def _bass_static(dl: DrawList, geo: Geometry) -> None:
     dl.add("sphere", sphere_transforms([nut_c + 0.10 * up - 0.02 * b.front], 0.05), WOOD)
     # fingerboard: a long thin box from the nut down past the neck joint
     fb_end = nut_c + 0.78 * (bridge_c - nut_c)
-    mid = (nut_c + fb_end) / 2 - 0.008 * b.front
+    mid = (nut_c + fb_end) / 2 - 0.011 * b.front  # its face 4 mm behind the strings
     length = float(np.linalg.norm(fb_end - nut_c))
     dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], _orient(b)[None]), EBONY)
     # bridge and tailpiece
@@ -200,7 +201,13 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     _kit_dynamic(dl, geo, pose)
     _strings(dl, geo, pose)
     _figure(dl, pose.drums, DRUMMER_SHIRT)
-    _figure(dl, pose.bass, BASSIST_SHIRT)
+    fingers = np.asarray(pose.bass_fingers, dtype=np.float64).reshape(-1, 2, 3)
+    if len(fingers):
+        # fingers instead of the one-piece hands: a palm to the knuckles, two bones a finger
+        _figure(dl, pose.bass, BASSIST_SHIRT, skip=("LeftHandEnd", "RightHandEnd"))
+        _fingers(dl, pose.bass, fingers)
+    else:
+        _figure(dl, pose.bass, BASSIST_SHIRT)
     s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
     dl.add("cylinder", segment_transforms(s[:, 0], s[:, 1], 0.0075), STICK)
     dl.add("sphere", sphere_transforms(s[:, 1], 0.009), STICK)
@@ -282,12 +289,27 @@ def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) ->
         dl.add("cylinder", segment_transforms(pts[:-1], pts[1:], radius * 1.3), STRING_HOT)
 
 
-def _figure(dl: DrawList, fig: FigurePose, shirt: tuple[float, ...]) -> None:
+def _fingers(dl: DrawList, fig: FigurePose, bones: F64) -> None:
+    """The bassist's finger bones (k, 2, 3) with a palm from each wrist to its knuckles."""
+    names = list(fig.names)
+    pos = np.asarray(fig.positions, dtype=np.float64)
+    half = LEFT_BONES
+    for wrist, knuckles in (("LeftHand", bones[:8:2, 0]), ("RightHand", bones[half : half + 4 : 2, 0])):
+        if len(knuckles):
+            w = pos[names.index(wrist)]
+            dl.add("cylinder", segment_transforms([w], [knuckles.mean(axis=0)], 0.022), SKIN)
+    dl.add("cylinder", segment_transforms(bones[:, 0], bones[:, 1], 0.0075), SKIN)
+    dl.add("sphere", sphere_transforms(bones[:, 1], 0.008), SKIN)
+
+
+def _figure(
+    dl: DrawList, fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ...] = ()
+) -> None:
     pos = np.asarray(fig.positions, dtype=np.float64)
     parents = np.asarray(fig.parents)
     radii = np.asarray(fig.radii, dtype=np.float64)
     names = list(fig.names)
-    is_head = np.array([n.lower() in ("head", "headend") for n in names])
+    is_head = np.array([n.lower() in ("head", "headend") or n in skip for n in names])
     child = np.nonzero((parents >= 0) & ~is_head)[0]
     colors = np.array([_limb_color(names[i], shirt) for i in child])
     dl.add("cylinder", segment_transforms(pos[parents[child]], pos[child], radii[child]), colors)

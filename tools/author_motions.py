@@ -333,8 +333,9 @@ def finger_hand(
 LEFT_POLE = np.array([0.45, -0.35, -0.10])
 # the fretting hand comes round the neck from its E side (the player's left, where the
 # arm is): from the wrist to the fingertip mostly across the fingerboard toward the G
-# side, a little forward onto the string and down the neck; the thumb stays behind
-FRET_HAND_DIR = (-0.80, 0.30, -0.45)  # (lateral toward E, front, axis toward the scroll)
+# side level with the strings (over the fingerboard, never through it) and down the
+# neck; the thumb (virja.motion.bassist) stays behind the neck
+FRET_HAND_DIR = (-0.85, 0.0, -0.45)  # (lateral toward E, front, axis toward the scroll)
 
 
 def fret_hand(body: Body, geo: Geometry, tip: np.ndarray) -> bool:

@@ -263,7 +263,7 @@ class BandAnimator:
                 if current and current[-1].clip.string == p.string:
                     left.add(self._hold("fret_open", p))
             self._add_hit(Hit(p.impact, p.string, p.velocity))
-            self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity)
+            self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity, p.start)
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
 

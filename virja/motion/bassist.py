@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from virja.geometry import Geometry
-from virja.motion import ik, quat
+from virja.motion import quat
 from virja.motion.skeleton import SKELETON
 
 _SK = SKELETON
@@ -79,6 +79,7 @@ class BassistSettings:
 @dataclass
 class _Note:
     impact: float
+    start: float  # when the hands start moving toward it
     note: int
     string: str
     fret: int
@@ -86,6 +87,51 @@ class _Note:
     velocity: int
     right_finger: int  # 0 index, 1 middle
     off: float = math.inf
+
+
+_ARMS = [_SK.index("LeftArm"), _SK.index("RightArm")]
+_FORES = [_SK.index("LeftForeArm"), _SK.index("RightForeArm")]
+_HANDS = [_SK.index("LeftHand"), _SK.index("RightHand")]
+_SHOULDERS = [_SK.index("LeftShoulder"), _SK.index("RightShoulder")]
+
+
+def _frames(direction: np.ndarray, hinge: np.ndarray) -> np.ndarray:
+    """(k, 3, 3) frames with columns (direction, hinge made perpendicular, their cross)."""
+    d = direction / np.linalg.norm(direction, axis=-1, keepdims=True)
+    h = hinge - np.sum(hinge * d, axis=-1, keepdims=True) * d
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    return np.stack([d, h, np.cross(d, h)], axis=-1)
+
+
+_REST_T = _frames(_ARM_REST_DIR[None], _ARM_REST_HINGE[None])[0].T
+
+
+def _two_bone(
+    roots: np.ndarray, targets: np.ndarray, poles: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations (k, 4) of upper and lower arm putting each wrist on its target,
+    bending toward its pole: :func:`virja.motion.ik.two_bone` for several arms at once
+    (targets out of reach are clamped)."""
+    a_len, b_len = _ARM_LEN
+    to = targets - roots
+    dist = np.linalg.norm(to, axis=-1)
+    d = np.clip(dist, abs(a_len - b_len) + 1e-6, a_len + b_len - 1e-6)
+    u = to / dist[:, None]
+    v = poles - roots
+    v = v - np.sum(v * u, axis=-1, keepdims=True) * u
+    v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    cos_a = (a_len**2 + d**2 - b_len**2) / (2 * a_len * d)
+    ang = np.arccos(np.clip(cos_a, -1.0, 1.0))[:, None]
+    elbow = roots + a_len * (np.cos(ang) * u + np.sin(ang) * v)
+    end = roots + d[:, None] * u
+    u1 = (elbow - roots) / np.linalg.norm(elbow - roots, axis=-1, keepdims=True)
+    u2 = (end - elbow) / np.linalg.norm(end - elbow, axis=-1, keepdims=True)
+    hinge = np.cross(u1, u2)
+    straight = np.linalg.norm(hinge, axis=-1) < 1e-9  # a straight arm bends toward its pole
+    hinge[straight] = np.cross(u1[straight], v[straight])
+    upper = quat.from_matrix(_frames(u1, hinge) @ _REST_T)
+    lower = quat.from_matrix(_frames(u2, hinge) @ _REST_T)
+    return upper, lower
 
 
 def _position_of(motion: str, fret: int) -> int:
@@ -114,13 +160,26 @@ class Bassist:
 
     # -- input ------------------------------------------------------------------
 
-    def add(self, impact: float, note: int, string: str, fret: int, motion: str, velocity: int) -> None:
-        """A planned bass note (its impact, string, fret, motion name, loudness)."""
+    def add(
+        self,
+        impact: float,
+        note: int,
+        string: str,
+        fret: int,
+        motion: str,
+        velocity: int,
+        start: float | None = None,
+    ) -> None:
+        """A planned bass note (its impact, string, fret, motion name, loudness, start)."""
         i = bisect.bisect_right(self._times, impact)
         finger = (self._notes[i - 1].right_finger + 1) % 2 if i > 0 else 0
+        begin = min(impact, start if start is not None else impact - 0.1)
+        if i > 0:  # a hand starts toward a note only once it has struck the one before
+            begin = max(begin, self._notes[i - 1].impact)
         self._times.insert(i, impact)
         self._notes.insert(
-            i, _Note(impact, note, string, fret, _position_of(motion, fret), velocity, finger)
+            i,
+            _Note(impact, begin, note, string, fret, _position_of(motion, fret), velocity, finger),
         )
 
     def note_off(self, note: int, time_s: float) -> None:
@@ -161,46 +220,69 @@ class Bassist:
         segs += self._right(t, wpos)
         return np.array([[a, b] for a, b in segs]).reshape(-1, 2, 3)
 
-    def _left(self, t: float, wpos: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    def _incoming(self, t: float, stopped: bool) -> tuple[_Note | None, _Note | None, float]:
+        """(previous, next, w): the hand goes from ``previous``'s note to ``next``'s, ``w``
+        0..1 of the way (1 once ``next`` is struck); only stopped notes if ``stopped``."""
+        nxt: _Note | None = None
+        prev: _Note | None = None
+        i = bisect.bisect_right(self._times, t + 1.0)  # approaches last well under 1 s
+        for n in reversed(self._notes[max(0, i - 48) : i]):
+            if stopped and n.fret <= 0:
+                continue
+            if nxt is None:
+                if n.start <= t:
+                    nxt = n
+                continue
+            prev = n
+            break
+        if nxt is None:
+            return None, None, 1.0
+        span = nxt.impact - nxt.start
+        u = 1.0 if span <= 1e-9 else min(max((t - nxt.start) / span, 0.0), 1.0)
+        return prev, nxt, u * u * (3.0 - 2.0 * u)
+
+    def _layout(self, n: _Note | None) -> tuple[np.ndarray, np.ndarray]:
+        """Fingertip offsets (4, 3) from the stopping fingertip, and the thumb tip (3,),
+        for the hand position of stopped note ``n`` (the rest position for None)."""
         s = self.settings
         b = self.geometry.bass
-        tip = wpos[_SK.index("LeftHandEnd")]
-        wrist = wpos[_SK.index("LeftHand")]
-        held = self.fretted(t)
-        last = self.current(t)
-        string = held.string if held is not None else "D"
-        fret = held.fret if held is not None else 5
-        pos = held.position if held is not None else 5
-        pressing = (
-            held is not None
-            and last is held
-            and t < held.off
-            and held.impact <= t
-        )
+        string, fret, pos = (n.string, n.fret, n.position) if n is not None else ("D", 5, 5)
         thumb_pos = pos >= s.thumb_position_fret
         offsets = _THUMB_OFFSETS if thumb_pos else _LOW_OFFSETS
         step = fret - pos
         k = min(max(step, 0), 3) if thumb_pos else _FINGER_OF_STEP_LOW.get(step, 0)
         along = b.string_dir(string)  # toward the bridge: higher frets
-        fret_gap = b.fret_distance(min(fret + 1, b.max_fret)) - b.fret_distance(fret)
-        fret_gap = max(fret_gap, 0.02)
-        front = b.front
-        # the knuckles lie behind the pressing fingertip, toward the wrist and off the board
+        gap = max(b.fret_distance(min(fret + 1, b.max_fret)) - b.fret_distance(fret), 0.02)
+        tips = np.array([(off - offsets[k]) * gap * along for off in offsets])
+        middle_fret = min(pos + 1, b.max_fret)
+        centre = 0.5 * (b.string_point("A", middle_fret) + b.string_point("D", middle_fret))
+        return tips, centre - s.thumb_behind_m * b.front
+
+    def _left(self, t: float, wpos: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        s = self.settings
+        front = self.geometry.bass.front
+        tip = wpos[_SK.index("LeftHandEnd")]
+        wrist = wpos[_SK.index("LeftHand")]
+        prev, nxt, w = self._incoming(t, stopped=True)
+        tips_a, thumb_a = self._layout(prev if prev is not None else nxt)
+        tips_b, thumb_b = self._layout(nxt)
+        offs = (1.0 - w) * tips_a + w * tips_b
+        thumb_tip = (1.0 - w) * thumb_a + w * thumb_b
+        last = self.current(t)
+        pressing = nxt is not None and last is nxt and t < nxt.off and nxt.impact <= t
+        # the stopping finger: the one with no offset; the others hover, all lift when free
+        stopping = int(np.argmin(np.linalg.norm(tips_b, axis=1)))
+        press = 1.0 if pressing else 0.0
         back = _unit(wrist - tip)
         out: list[tuple[np.ndarray, np.ndarray]] = []
-        for i, off in enumerate(offsets):
-            shift = (off - offsets[k]) * fret_gap * along
-            if i == k:
-                ftip = tip + (0.0 if pressing else s.lift_m) * front
-            else:
-                ftip = tip + shift + (s.hover_m if pressing else s.lift_m) * front
-            knuckle = tip + shift * 0.6 + s.finger_len_m * back
+        for i in range(4):
+            rise = (s.hover_m if i != stopping else 0.0) * press + s.lift_m * (1.0 - press)
+            # near the impact the stopping finger comes down with the hand (clip) itself
+            ftip = tip + offs[i] + rise * front
+            knuckle = tip + offs[i] * 0.6 + s.finger_len_m * back
             mid = 0.5 * (knuckle + ftip) + 0.35 * s.finger_len_m * front  # arched over the string
             out += [(knuckle, mid), (mid, ftip)]
         # the thumb: behind the neck, opposite the second finger
-        middle_fret = min(pos + 1, b.max_fret)
-        centre = 0.5 * (b.string_point("A", middle_fret) + b.string_point("D", middle_fret))
-        thumb_tip = centre - s.thumb_behind_m * front
         thumb_base = wrist + 0.3 * (tip - wrist)
         thumb_mid = 0.5 * (thumb_base + thumb_tip) - 0.01 * front
         out += [(thumb_base, thumb_mid), (thumb_mid, thumb_tip)]
@@ -211,19 +293,21 @@ class Bassist:
         b = self.geometry.bass
         tip = wpos[_SK.index("RightHandEnd")]
         wrist = wpos[_SK.index("RightHand")]
-        last = self.current(t)
-        finger = last.right_finger if last is not None else 0
-        string = last.string if last is not None else "A"
-        along = b.string_dir(string)
+        prev, nxt, w = self._incoming(t, stopped=False)
+        finger = nxt.right_finger if nxt is not None else 0
+        # the finger that plucked last rests; the one about to pluck comes to the string
+        plucking = np.zeros(2)
+        plucking[finger] = w if prev is not None else 1.0
+        plucking[1 - finger] = 1.0 - plucking[finger]
+        along = b.string_dir("A")
         back = _unit(wrist - tip)
         out: list[tuple[np.ndarray, np.ndarray]] = []
         # index nearer the fingerboard (toward the nut), middle beside it toward the bridge
         for i in (0, 1):
-            if i == finger:
-                ftip = tip
-            else:
-                ftip = tip + (0.02 if i == 1 else -0.02) * along + s.hover_m * 2 * b.front
-            knuckle = tip + (0.012 if i == 1 else -0.012) * along + s.finger_len_m * back
+            side = 0.02 if i == 1 else -0.02
+            rest = side * along + s.hover_m * 2 * b.front
+            ftip = tip + (1.0 - plucking[i]) * rest
+            knuckle = tip + 0.6 * side * along + s.finger_len_m * back
             mid = 0.5 * (knuckle + ftip) + 0.25 * s.finger_len_m * b.front
             out += [(knuckle, mid), (mid, ftip)]
         # ring and little curled into the palm, the thumb resting on the fingerboard's edge
@@ -241,7 +325,7 @@ class Bassist:
         if i == 0:
             return np.zeros(3)
         n = self._notes[i - 1]
-        nxt = self._notes[i].impact if i < len(self._notes) else math.inf
+        nxt = self._notes[i].start if i < len(self._notes) else math.inf
         end = min(n.off, nxt)
         held = t - n.impact
         if n.fret <= 0 or held < s.vibrato_after_s or end - n.impact < s.long_note_s or t >= end:
@@ -272,11 +356,17 @@ class Bassist:
         if held is not None:
             down = self.geometry.bass.fret_distance(held.fret)
         turn = s.turn_rad_per_m * down
-        # less of it where an arm at full stretch could no longer keep its hand in place
-        for k in (1.0, 0.5, 0.0):
-            out, reached = self._moved(loc, root, wpos, wrot, k * sway, k * dip, k * turn, t)
-            if reached:
-                break
+        return self._moved(loc, root, wpos, wrot, sway, dip, turn, t)
+
+    def _torso(self, loc: np.ndarray, sway: float, dip: float, turn: float) -> np.ndarray:
+        out = loc.copy()
+        hips, spine, chest = _SK.index("Hips"), _SK.index("Spine"), _SK.index("Chest")
+        q_sway = quat.from_axis_angle([0.0, 0.0, 1.0], sway)
+        out[hips] = quat.multiply(out[hips], q_sway)
+        legs = [_SK.index("LeftUpLeg"), _SK.index("RightUpLeg")]
+        out[legs] = quat.multiply(quat.conjugate(q_sway), out[legs])  # the legs stay put
+        out[spine] = quat.multiply(out[spine], quat.from_axis_angle([1.0, 0.0, 0.0], dip))
+        out[chest] = quat.multiply(out[chest], quat.from_axis_angle([0.0, 1.0, 0.0], turn))
         return out
 
     def _moved(
@@ -289,34 +379,33 @@ class Bassist:
         dip: float,
         turn: float,
         t: float,
-    ) -> tuple[np.ndarray, bool]:
-        out = loc.copy()
-        hips, spine, chest = _SK.index("Hips"), _SK.index("Spine"), _SK.index("Chest")
-        q_sway = quat.from_axis_angle([0.0, 0.0, 1.0], sway)
-        out[hips] = quat.multiply(out[hips], q_sway)
-        inv = quat.conjugate(q_sway)
-        for leg in ("LeftUpLeg", "RightUpLeg"):  # the legs keep standing where they stood
-            j = _SK.index(leg)
-            out[j] = quat.multiply(inv, out[j])
-        out[spine] = quat.multiply(out[spine], quat.from_axis_angle([1.0, 0.0, 0.0], dip))
-        out[chest] = quat.multiply(out[chest], quat.from_axis_angle([0.0, 1.0, 0.0], turn))
+    ) -> np.ndarray:
+        targets = wpos[_HANDS].copy()
+        targets[0] += self._vibrato(t)
+        out = self._torso(loc, sway, dip, turn)
         moved_pos, moved_rot = _SK.fk(out, root)
-        wobble = self._vibrato(t)
-        reached = True
-        for side in ("Left", "Right"):
-            arm, fore, hand = (_SK.index(f"{side}{j}") for j in ("Arm", "ForeArm", "Hand"))
-            shoulder = _SK.index(f"{side}Shoulder")
-            target = wpos[hand] + (wobble if side == "Left" else 0.0)
-            sol = ik.two_bone(
-                moved_pos[arm],
-                target,
-                wpos[fore] + (moved_pos[arm] - wpos[arm]),
-                *_ARM_LEN,
-                _ARM_REST_DIR,
-                _ARM_REST_HINGE,
-            )
-            reached = reached and sol.reached
-            out[arm] = ik.local_from_world(moved_rot[shoulder], sol.upper)
-            out[fore] = ik.local_from_world(sol.upper, sol.lower)
-            out[hand] = ik.local_from_world(sol.lower, wrot[hand])
-        return out, reached
+        # less of it where an arm near full stretch could no longer keep its hand in place:
+        # the largest share k of the motion (shoulders move about linearly with it) that
+        # leaves both wrists within reach
+        reach = _ARM_LEN[0] + _ARM_LEN[1] - 1e-3
+        k = 1.0
+        for i in range(2):
+            s0, s1 = wpos[_ARMS[i]], moved_pos[_ARMS[i]]
+            if np.linalg.norm(targets[i] - s1) > reach:
+                lo, hi = 0.0, 1.0
+                for _ in range(12):
+                    mid = 0.5 * (lo + hi)
+                    if np.linalg.norm(targets[i] - (s0 + mid * (s1 - s0))) > reach:
+                        hi = mid
+                    else:
+                        lo = mid
+                k = min(k, lo)
+        if k < 1.0:
+            out = self._torso(loc, k * sway, k * dip, k * turn)
+            moved_pos, moved_rot = _SK.fk(out, root)
+        poles = wpos[_FORES] + (moved_pos[_ARMS] - wpos[_ARMS])
+        upper, lower = _two_bone(moved_pos[_ARMS], targets, poles)
+        out[_ARMS] = quat.multiply(quat.conjugate(moved_rot[_SHOULDERS]), upper)
+        out[_FORES] = quat.multiply(quat.conjugate(upper), lower)
+        out[_HANDS] = quat.multiply(quat.conjugate(lower), wrot[_HANDS])
+        return out

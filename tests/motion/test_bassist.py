@@ -9,9 +9,9 @@ from virja.events import Beat, NoteOff
 from virja.geometry import GEOMETRY
 from virja.motion import quat
 from virja.motion.band import BandAnimator
-from virja.motion.bassist import LEFT_BONES
 from virja.motion.clip import MotionLibrary
 from virja.motion.metrics import contact_distance
+from virja.motion.pose import LEFT_FINGER_BONES
 from virja.motion.skeleton import SKELETON
 
 B = GEOMETRY.bass
@@ -68,7 +68,7 @@ def test_index_and_middle_pluck_in_turn(library: MotionLibrary) -> None:
     plucking = []
     for p in notes:
         pose = a.pose(p.impact)
-        right = pose.bass_fingers[LEFT_BONES:]
+        right = pose.bass_fingers[LEFT_FINGER_BONES:]
         tips = right[[1, 3], 1]  # index tip, middle tip
         plucking.append(int(np.argmin(np.linalg.norm(tips - pose.plucking_tip, axis=1))))
     assert plucking == [0, 1, 0, 1]
@@ -80,7 +80,10 @@ def test_the_body_moves_with_the_beat_and_the_hands_stay_on_the_strings(
     a = BandAnimator(library)
     for i in range(12):
         a.add_beat(Beat(0.5 * i, i // 4, i % 4 + 1, 4, 0, 500_000))
-    notes = [_note(s, f, 0.5 + 0.5 * i) for i, (s, f) in enumerate([("E", 1), ("A", 3), ("D", 5), ("G", 7)] * 2)]
+    notes = [
+        _note(s, f, 0.5 + 0.5 * i)
+        for i, (s, f) in enumerate([("E", 1), ("A", 3), ("D", 5), ("G", 7)] * 2)
+    ]
     for p in notes:
         a.add_planned(p)
     chest = SKELETON.index("Chest")
@@ -98,7 +101,10 @@ def test_vibrato_on_a_long_note_only(library: MotionLibrary) -> None:
     short.add_planned(_note("G", 5, 1.0))
     short.add_planned(_note("G", 7, 1.3))
     ts = np.arange(1.3, 1.9, 0.01)
-    moves = [np.ptp([a.pose(float(t)).fretting_tip @ B.string_dir("G") for t in ts]) for a in (long_, short)]
+    moves = [
+        np.ptp([a.pose(float(t)).fretting_tip @ B.string_dir("G") for t in ts])
+        for a in (long_, short)
+    ]
     assert 0.002 < moves[0] < 0.01
     assert long_.pose(1.0).fretting_tip is not None
     assert np.linalg.norm(long_.pose(1.0).fretting_tip - B.string_point("G", 5)) < 0.01

@@ -74,9 +74,10 @@ def test_a_shift_without_time_for_it_costs_more() -> None:
     fast = bass.transition(state, ((0, 10),), fg, gap_s=0.01)[0]
     assert fast == pytest.approx(slow + fg.rushed_shift_cost)
     # no shift, no hurry
-    assert bass.transition(state, ((1, 2),), fg, gap_s=0.01)[0] == bass.transition(
-        state, ((1, 2),), fg
-    )[0]
+    assert (
+        bass.transition(state, ((1, 2),), fg, gap_s=0.01)[0]
+        == bass.transition(state, ((1, 2),), fg)[0]
+    )
 
 
 @pytest.mark.parametrize("title", list(LINES))
@@ -150,9 +151,7 @@ def test_five_string_and_high_c_tunings_from_config(tmp_path) -> None:  # type: 
     assert bass.positions(c.bass, 23) == [(0, 0)]
 
 
-def _brute(
-    state: bass.BassState, groups: list[list[bass.BassOption]], gaps: list[float]
-) -> float:
+def _brute(state: bass.BassState, groups: list[list[bass.BassOption]], gaps: list[float]) -> float:
     return min(
         bass.path_cost(state, list(combo), gaps=gaps) for combo in itertools.product(*groups)
     )

@@ -68,6 +68,9 @@ class PlannedNoteLike(Protocol):
     def velocity(self) -> int: ...
 
     @property
+    def note(self) -> int: ...
+
+    @property
     def limb(self) -> str: ...
 
     @property

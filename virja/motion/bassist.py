@@ -47,7 +47,6 @@ _ARM_REST_HINGE = np.array([-1.0, 0.0, 0.0])
 _LOW_OFFSETS = (0.0, 1.0, 1.6, 2.0)
 _THUMB_OFFSETS = (0.0, 1.0, 2.0, 3.0)  # thumb position: one finger a fret
 _FINGER_OF_STEP_LOW = {0: 0, 1: 1, 2: 3}  # frets above the position -> finger (0 = index)
-LEFT_BONES = 10  # :meth:`Bassist.fingers` gives the left hand's bones first (4 fingers, thumb)
 
 
 @dataclass(frozen=True)
@@ -134,11 +133,16 @@ def _two_bone(
     return upper, lower
 
 
-def _position_of(motion: str, fret: int) -> int:
+def position_of(motion: str) -> int | None:
+    """The hand position a bass motion name carries (``pluck_A_fret3_pos2`` -> 2; the
+    planner writes it, :func:`virja.plan.bass.motion_name`), None if it carries none."""
     _, sep, tail = motion.rpartition("_pos")
-    if sep and tail.isdigit():
-        return int(tail)
-    return max(fret, 1)
+    return int(tail) if sep and tail.isdigit() else None
+
+
+def _position_of(motion: str, fret: int) -> int:
+    pos = position_of(motion)
+    return pos if pos is not None else max(fret, 1)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -28,16 +28,20 @@ import numpy as np
 
 from virja.motion import quat
 from virja.motion.band import BandAnimator, PlannedNoteLike
+from virja.motion.bassist import position_of
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
-from virja.plan.bass import position_of
 
 _SK = SKELETON
 BOARD_HALF_WIDTH_M = 0.035
 BOARD_FACE_M = -0.004  # the fingerboard's face, behind the strings (render.scene)
 BOARD_BACK_M = -0.030  # the neck's back
-SEGMENTS = (("LeftForeArm", "LeftHand"), ("LeftHand", "LeftHandEnd"))
-SEGMENTS += (("RightForeArm", "RightHand"), ("RightHand", "RightHandEnd"))
+SEGMENTS = (
+    ("LeftForeArm", "LeftHand"),
+    ("LeftHand", "LeftHandEnd"),
+    ("RightForeArm", "RightHand"),
+    ("RightHand", "RightHandEnd"),
+)
 
 # targets (issue 16, as for the drummer where they apply)
 TARGETS = {
@@ -123,7 +127,9 @@ def _frames(animator: BandAnimator, times: np.ndarray) -> tuple[np.ndarray, np.n
     return np.array(pos), np.array(rot), np.array(fingers)
 
 
-def _neck_frame(animator: BandAnimator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+def _neck_frame(
+    animator: BandAnimator,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     b = animator.geometry.bass
     lateral = np.cross(b.axis, b.front)
     lateral /= np.linalg.norm(lateral)
@@ -142,8 +148,12 @@ def _in_board(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
     lat = rel @ lateral
     # the strings rise off the board toward the bridge: measure from the string line
     fr = rel @ front
-    return (u > 0.0) & (u < length) & (np.abs(lat) < BOARD_HALF_WIDTH_M) & (fr < BOARD_FACE_M) & (
-        fr > BOARD_BACK_M
+    return (
+        (u > 0.0)
+        & (u < length)
+        & (np.abs(lat) < BOARD_HALF_WIDTH_M)
+        & (fr < BOARD_FACE_M)
+        & (fr > BOARD_BACK_M)
     )
 
 

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+LEFT_FINGER_BONES = 10  # the fretting hand's bones in ``BandPose.bass_fingers``
+
 
 @dataclass(frozen=True)
 class FigurePose:
@@ -55,7 +57,10 @@ class BandPose:
     - ``fretting_tip``: (3,) the bassist's left (fretting) fingertip, metres;
     - ``plucking_tip``: (3,) the bassist's right (plucking) fingertip, metres;
     - ``bass_fingers``: (k, 2, 3) the bassist's finger bones (from, to), metres
-      (:mod:`virja.motion.bassist`; empty when not drawn).
+      (:mod:`virja.motion.bassist`; empty when not drawn): the fretting hand's
+      first (:data:`LEFT_FINGER_BONES`: index, middle, ring, little, two bones
+      each, then the thumb's two), then the plucking hand's (index, middle, two
+      bones each, ring and little curled, the thumb).
     """
 
     time_s: float

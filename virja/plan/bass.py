@@ -123,11 +123,7 @@ def hand_positions(fingering: Fingering, low: int, high: int) -> tuple[int, ...]
     """Positions whose span covers frets ``low..high`` (lowest first); if none can,
     those covering ``high`` alone (a stretch for the other finger)."""
     widest = max(fingering.span_frets, fingering.thumb_span_frets)
-    out = tuple(
-        h
-        for h in range(max(1, high - widest), low + 1)
-        if high <= h + fingering.span(h)
-    )
+    out = tuple(h for h in range(max(1, high - widest), low + 1) if high <= h + fingering.span(h))
     if out or low == high:
         return out
     return hand_positions(fingering, high, high)
@@ -155,9 +151,7 @@ def transitions(
     low, high = _stops(option) or (a[1], a[1])
     per = fingering.position_cost_per_fret
     if state is None:
-        return [
-            (per * (h - 1), (a[0], a[1], h)) for h in hand_positions(fingering, low, high)
-        ]
+        return [(per * (h - 1), (a[0], a[1], h)) for h in hand_positions(fingering, low, high)]
     s0, f0, h0 = state
     base = float(abs(a[1] - f0) + abs(a[0] - s0))
     if h0 <= low and high <= h0 + fingering.span(h0):
@@ -233,7 +227,7 @@ def solve(
         gap = math.inf if gaps is None else gaps[gi]
         # :func:`transitions` inlined, with what does not depend on the previous state
         # worked out once per group (same arithmetic, same order, same results)
-        prepared = []
+        prepared: list[tuple[Position | None, int, int, int, tuple[int, ...]]] = []
         for opt in options:
             a = anchor(opt)
             if a is None:

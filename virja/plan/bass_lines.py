@@ -91,7 +91,8 @@ def fingering_table(
 def markdown(title: str, rows: list[Fingered]) -> str:
     """One line per note: name, string and fret, position, shift."""
     cells = [
-        f"{note_name(r.note)} {r.string}{r.fret}" + (f"/{r.position}" if r.position else "")
+        f"{note_name(r.note)} {r.string}{r.fret}"
+        + (f"/{r.position}" if r.position else "")
         + ("*" if r.shifted else "")
         for r in rows
     ]

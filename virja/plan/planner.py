@@ -676,8 +676,8 @@ class OnlinePlanner:
                 opts = [(p,) for p in bass_mod.positions(self.config.bass, rec.played)]
                 fingering = self.config.bass.fingering
                 best = min(opts, key=lambda o: bass_mod.transition(chain.state, o, fingering)[0])
-                cost, hand = bass_mod.transition(chain.state, best, fingering)
-                self._emit_bass_group(chain, [rec], [rec.played], best, cost, hand)
+                cost, after = bass_mod.transition(chain.state, best, fingering)
+                self._emit_bass_group(chain, [rec], [rec.played], best, cost, after)
             return
         assert rec.drum is not None
         piece = rec.drum.piece

@@ -17,8 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
-from virja.motion.bassist import LEFT_BONES
-from virja.motion.pose import BandPose, FigurePose
+from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
     box_transforms,
     disc_transforms,
@@ -293,8 +292,11 @@ def _fingers(dl: DrawList, fig: FigurePose, bones: F64) -> None:
     """The bassist's finger bones (k, 2, 3) with a palm from each wrist to its knuckles."""
     names = list(fig.names)
     pos = np.asarray(fig.positions, dtype=np.float64)
-    half = LEFT_BONES
-    for wrist, knuckles in (("LeftHand", bones[:8:2, 0]), ("RightHand", bones[half : half + 4 : 2, 0])):
+    half = LEFT_FINGER_BONES
+    for wrist, knuckles in (
+        ("LeftHand", bones[:8:2, 0]),
+        ("RightHand", bones[half : half + 4 : 2, 0]),
+    ):
         if len(knuckles):
             w = pos[names.index(wrist)]
             dl.add("cylinder", segment_transforms([w], [knuckles.mean(axis=0)], 0.022), SKIN)

@@ -403,15 +403,17 @@ def pluck(geo: Geometry, string: str) -> tuple[np.ndarray, np.ndarray, float]:
     b = geo.bass
     lateral = _unit(np.cross(b.axis, b.front))
     p = b.pluck_point(string)
-    ready = right_ready(geo)
+    # pizzicato from the side: the hand waits just off its string and the finger does
+    # the work, so the arm stays almost still (a few cm, not the whole forearm)
+    ready = p + 0.015 * b.front + 0.008 * lateral
     prep = _on_frame(0.14)
     keys = [
         (0.0, ready, "smooth"),
-        (0.6 * prep, p + 0.012 * b.front + 0.01 * lateral, "smooth"),
+        (0.6 * prep, p + 0.008 * b.front + 0.006 * lateral, "smooth"),
         (prep, p, "accel"),  # finger on the string at the moment it lets go
         (
             prep + 0.06,
-            p + 0.03 * lateral - 0.004 * b.front,
+            p + 0.02 * lateral - 0.004 * b.front,
             "decel",
         ),  # pull through toward the next string
         (_on_frame(prep + 0.30), ready, "smooth"),

@@ -130,24 +130,26 @@ def _frames(animator: BandAnimator, times: np.ndarray) -> tuple[np.ndarray, np.n
 def _neck_frame(
     animator: BandAnimator,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """(nut centre, along the strings, lateral toward E, out of the board face, board
+    length): the fingerboard as render.scene draws it, along the strings."""
     b = animator.geometry.bass
-    lateral = np.cross(b.axis, b.front)
-    lateral /= np.linalg.norm(lateral)
-    nut = np.mean([b.nut[s] for s in animator.bass_strings], axis=0)
-    bridge = np.mean([b.bridge[s] for s in animator.bass_strings], axis=0)
+    nut = np.mean([b.nut[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
+    bridge = np.mean([b.bridge[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
     along = bridge - nut
     length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
-    return nut, along / np.linalg.norm(along), lateral, b.front, length
+    along = along / np.linalg.norm(along)
+    face = b.front - np.dot(b.front, along) * along
+    face = face / np.linalg.norm(face)
+    return nut, along, np.cross(face, along), face, length  # lateral: + toward E
 
 
 def _in_board(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
-    """Which points (..., 3) lie inside the fingerboard and neck."""
-    nut, along, lateral, front, length = _neck_frame(animator)
+    """Which points (..., 3) lie inside the fingerboard and the neck behind it."""
+    nut, along, lateral, face, length = _neck_frame(animator)
     rel = points - nut
     u = rel @ along
     lat = rel @ lateral
-    # the strings rise off the board toward the bridge: measure from the string line
-    fr = rel @ front
+    fr = rel @ face
     return (
         (u > 0.0)
         & (u < length)

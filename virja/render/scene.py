@@ -167,10 +167,16 @@ def _bass_static(dl: DrawList, geo: Geometry) -> None:
     )
     dl.add("sphere", sphere_transforms([nut_c + 0.10 * up - 0.02 * b.front], 0.05), WOOD)
     # fingerboard: a long thin box from the nut down past the neck joint
+    # (along the strings, which rise off the neck toward the bridge: its face stays 4 mm
+    # behind them from the nut down)
     fb_end = nut_c + 0.78 * (bridge_c - nut_c)
-    mid = (nut_c + fb_end) / 2 - 0.011 * b.front  # its face 4 mm behind the strings
+    along = (fb_end - nut_c) / np.linalg.norm(fb_end - nut_c)
+    face = b.front - np.dot(b.front, along) * along
+    face /= np.linalg.norm(face)
+    board = np.stack([np.cross(along, face), along, face], axis=1)
+    mid = (nut_c + fb_end) / 2 - 0.011 * face
     length = float(np.linalg.norm(fb_end - nut_c))
-    dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], _orient(b)[None]), EBONY)
+    dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], board[None]), EBONY)
     # bridge and tailpiece
     dl.add(
         "box",

@@ -370,7 +370,7 @@ def bass_ready(body: Body, geo: Geometry) -> None:
 def right_ready(geo: Geometry) -> np.ndarray:
     b = geo.bass
     mid = 0.5 * (b.pluck_point("A") + b.pluck_point("D"))
-    return np.asarray(mid + 0.04 * b.front)
+    return np.asarray(mid + 0.015 * b.front)
 
 
 def fret_hold(geo: Geometry, string: str | None, fret: int) -> tuple[np.ndarray, np.ndarray, float]:
@@ -403,9 +403,9 @@ def pluck(geo: Geometry, string: str) -> tuple[np.ndarray, np.ndarray, float]:
     b = geo.bass
     lateral = _unit(np.cross(b.axis, b.front))
     p = b.pluck_point(string)
-    # pizzicato from the side: the hand waits just off its string and the finger does
-    # the work, so the arm stays almost still (a few cm, not the whole forearm)
-    ready = p + 0.015 * b.front + 0.008 * lateral
+    # pizzicato from the side: the hand waits just off the middle strings and the
+    # finger does the work, so the arm stays almost still (a few cm, not the forearm)
+    ready = right_ready(geo)
     prep = _on_frame(0.14)
     keys = [
         (0.0, ready, "smooth"),

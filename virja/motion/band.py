@@ -390,6 +390,9 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
+        for k, t in enumerate(ts.tolist()):  # the bassist's body: per frame (IK, not batched)
+            index, phase = self._beat_phase(t)
+            out[k, 1] = self.bassist.body(out[k, 1], self._roots[1], t, phase, index)
         return out
 
     def _nod_many(self, t: np.ndarray) -> np.ndarray:
@@ -439,6 +442,7 @@ class BandAnimator:
                     string_stops=self._stops(t),
                     fretting_tip=p[1, _SK.index("LeftHandEnd")].copy(),
                     plucking_tip=p[1, _SK.index("RightHandEnd")].copy(),
+                    bass_fingers=self.bassist.fingers(t, p[1]),
                 )
             )
         return out

@@ -66,9 +66,9 @@ def run(args: argparse.Namespace) -> int:
     from virja.events import NoteOn
     from virja.midifile import read_midi
     from virja.motion.band import BandAnimator
+    from virja.motion.bassist_report import measure_bassist
     from virja.motion.drummer_report import measure_drummer
     from virja.motion.metrics import CONTACT_TOLERANCE_M, measure
-    from virja.motion.bassist_report import measure_bassist
     from virja.plan import load_plan_config, plan_notes_with_report
     from virja.routing import Router, route_all
 

@@ -350,7 +350,11 @@ class Bassist:
         wpos, wrot = _SK.fk(loc, root)
         held = self.fretted(t)
         last = self.current(t)
-        loud = 0.6 + 0.4 * (last.velocity / 127 if last is not None else 0.5)
+        if last is None:  # before the first note the player stands still
+            return loc
+        # playing: full size; 2 s after the last note the body settles over a second
+        settle = min(max(3.0 - (t - last.impact), 0.0), 1.0)
+        loud = (0.6 + 0.4 * last.velocity / 127) * settle
         # weight from one foot to the other over two beats; a dip of the spine on each beat
         two = (beat_index % 2 + beat_phase) / 2.0
         sway = s.sway_rad * loud * math.sin(2 * math.pi * two)

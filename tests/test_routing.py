@@ -21,10 +21,23 @@ def test_gm_bass_program_goes_to_the_bassist() -> None:
     assert r.route(NoteOn(0.1, 2, 40, 90)) == "bass"
 
 
-def test_piano_part_never_reaches_the_bassist_even_on_a_bass_named_track() -> None:
-    r = Router(track_names={1: "Bass"})
+def test_a_bass_named_track_is_the_bassists_whatever_its_program_and_the_report_says_so() -> None:
+    r = Router(track_names={1: "Bass", 2: "Piano"})
+    r.route(ProgramChange(0, 0, 25, track=1))  # GM 26, a steel guitar
+    assert r.route(NoteOn(0.1, 0, 40, 90, track=1)) == "bass"
+    r.route(ProgramChange(0, 1, 0, track=2))
+    assert r.route(NoteOn(0.1, 1, 60, 90, track=2)) is None  # a piano part stays the piano's
+    (line,) = [x for x in r.report() if "'Bass'" in x]
+    assert "bassist" in line and "GM program 26 is not a bass" in line
+
+
+def test_configuration_lets_the_program_win_over_the_name() -> None:
+    cfg = RoutingConfig.from_dict({"names_over_programs": False})
+    r = Router(cfg, track_names={1: "Bass"})
     r.route(ProgramChange(0, 0, 0, track=1))  # the program says piano
     assert r.route(NoteOn(0.1, 0, 40, 90, track=1)) is None
+    with pytest.raises(ConfigError, match="true or false"):
+        RoutingConfig.from_dict({"names_over_programs": "yes"})
 
 
 def test_bass_named_track_without_program_goes_to_the_bassist() -> None:

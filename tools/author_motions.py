@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from virja.geometry import BASS_STRINGS, GEOMETRY, Geometry
+from virja.geometry import ALL_BASS_STRINGS, GEOMETRY, Geometry
 from virja.motion import ik, quat
 from virja.motion.bvh import Bvh, BvhJoint, write_bvh
 from virja.motion.skeleton import (
@@ -331,19 +331,46 @@ def finger_hand(
 
 
 LEFT_POLE = np.array([0.45, -0.35, -0.10])
+# the fretting hand comes round the neck from its E side (the player's left, where the
+# arm is): from the wrist to the fingertip mostly across the fingerboard toward the G
+# side level with the strings (over the fingerboard, never through it) and down the
+# neck; the thumb (virja.motion.bassist) stays behind the neck
+FRET_HAND_DIR = (-0.85, 0.0, -0.45)  # (lateral toward E, front, axis toward the scroll)
+
+
+def fret_hand(body: Body, geo: Geometry, tip: np.ndarray) -> bool:
+    """Pose the left arm with its fingertip at ``tip``, the hand round the neck's E side
+    (where the arm cannot reach so far round, high up the low strings, less far)."""
+    b = geo.bass
+    lateral = _unit(np.cross(b.axis, b.front))
+    lt, fr, ax = FRET_HAND_DIR
+    want = _unit(lt * lateral + fr * b.front + ax * b.axis)
+    shoulder = body.pos("LeftArm")
+    plain = _unit(_unit(tip - shoulder) - 0.8 * b.front)  # straight at the string
+    for w in (1.0, 0.8, 0.6, 0.4, 0.2, 0.0):
+        d = _unit(w * want + (1.0 - w) * plain)
+        hand = ik.aim(np.array([0.0, -1.0, 0]), np.array([1.0, 0, 0]), d, -b.front)
+        wrist = tip - quat.rotate(hand, HAND_END)
+        trial = body.copy()
+        if trial.arm("Left", wrist, hand, shoulder + LEFT_POLE):
+            body.local, body.wpos, body.wrot = trial.local, trial.wpos, trial.wrot
+            return True
+    return False
+
+
 RIGHT_POLE = np.array([-0.40, -0.40, -0.20])
 
 
 def bass_ready(body: Body, geo: Geometry) -> None:
     b = geo.bass
-    finger_hand(body, "Left", b.string_point("D", 5) + 0.04 * b.front, -b.front, LEFT_POLE)
+    fret_hand(body, geo, b.string_point("D", 5) + 0.02 * b.front)
     finger_hand(body, "Right", right_ready(geo), -b.front, RIGHT_POLE)
 
 
 def right_ready(geo: Geometry) -> np.ndarray:
     b = geo.bass
     mid = 0.5 * (b.pluck_point("A") + b.pluck_point("D"))
-    return np.asarray(mid + 0.04 * b.front)
+    return np.asarray(mid + 0.015 * b.front)
 
 
 def fret_hold(geo: Geometry, string: str | None, fret: int) -> tuple[np.ndarray, np.ndarray, float]:
@@ -364,7 +391,7 @@ def fret_hold(geo: Geometry, string: str | None, fret: int) -> tuple[np.ndarray,
     out = []
     for t in _frames(0.12):
         body = base.copy()
-        if not finger_hand(body, "Left", path(t), -b.front, LEFT_POLE):
+        if not fret_hand(body, geo, path(t)):
             raise SystemExit(f"fret {string}{fret}: out of reach")
         out.append(body.local.copy())
     return np.array(out), base.root, impact
@@ -376,15 +403,17 @@ def pluck(geo: Geometry, string: str) -> tuple[np.ndarray, np.ndarray, float]:
     b = geo.bass
     lateral = _unit(np.cross(b.axis, b.front))
     p = b.pluck_point(string)
+    # pizzicato from the side: the hand waits just off the middle strings and the
+    # finger does the work, so the arm stays almost still (a few cm, not the forearm)
     ready = right_ready(geo)
     prep = _on_frame(0.14)
     keys = [
         (0.0, ready, "smooth"),
-        (0.6 * prep, p + 0.012 * b.front + 0.01 * lateral, "smooth"),
+        (0.6 * prep, p + 0.008 * b.front + 0.006 * lateral, "smooth"),
         (prep, p, "accel"),  # finger on the string at the moment it lets go
         (
             prep + 0.06,
-            p + 0.03 * lateral - 0.004 * b.front,
+            p + 0.02 * lateral - 0.004 * b.front,
             "decel",
         ),  # pull through toward the next string
         (_on_frame(prep + 0.30), ready, "smooth"),
@@ -500,7 +529,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
         "the drummer's ready pose: sticks over the snare, feet on the pedals",
     )
     count += 1
-    for s in BASS_STRINGS:
+    for s in ALL_BASS_STRINGS:  # the five- and six-string basses' B and C too
         for f in range(1, MAX_FRET + 1):
             loc, root, imp = fret_hold(geo, s, f)
             meta = {

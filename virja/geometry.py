@@ -11,7 +11,10 @@ head, unit ``normal`` pointing out of the head, ``radius``, ``depth``) or a
 ``radius``, ``thickness``); strokes land on :meth:`DrumKit.strike_point`.
 Pedals are :class:`Pedal` (heel point, footboard direction, length).
 
-Bass: an upright 4-string bass; strings run from the nut to the bridge;
+Bass: an upright bass; strings run from the nut to the bridge.  The neck has
+room for six: the four-string E A D G in the middle, a low B beside the E and a
+high C beside the G (``ALL_BASS_STRINGS``); a figure plays and is drawn with the
+strings of its tuning (``BASS_STRINGS``, the four, by default);
 :meth:`UprightBass.string_point` is where a finger stops a string at a fret
 (equal-temperament distance ``scale * (1 - 2**(-fret/12))`` from the nut),
 :meth:`UprightBass.pluck_point` where the right hand plucks.
@@ -31,9 +34,11 @@ Vec = np.ndarray  # (3,) float64, metres
 DRUM_PIECES = ("kick", "snare", "tom_high", "tom_low", "tom_floor")
 CYMBAL_PIECES = ("hihat", "ride", "crash")
 PIECES = DRUM_PIECES + CYMBAL_PIECES
-BASS_STRINGS = ("E", "A", "D", "G")
-# sounding MIDI note of each open string (methods.md: E1 A1 D2 G2)
-OPEN_STRING_NOTES = MappingProxyType({"E": 28, "A": 33, "D": 38, "G": 43})
+BASS_STRINGS = ("E", "A", "D", "G")  # the four-string bass (the paper's), the default
+ALL_BASS_STRINGS = ("B", "E", "A", "D", "G", "C")  # low to high: five- and six-string basses
+# sounding MIDI note of each open string in standard tuning (methods.md: E1 A1 D2 G2;
+# B0 and C3 for five and six strings; drop tunings lower a string, see motions/bass.toml)
+OPEN_STRING_NOTES = MappingProxyType({"B": 23, "E": 28, "A": 33, "D": 38, "G": 43, "C": 48})
 
 
 def _v(x: float, y: float, z: float) -> Vec:
@@ -131,7 +136,8 @@ class DrumKit:
 
 @dataclass(frozen=True)
 class UprightBass:
-    """An upright bass: ``strings`` E A D G, each from its ``nut`` point to its ``bridge`` point.
+    """An upright bass: ``strings`` B E A D G C, each from its ``nut`` point to its ``bridge``
+    point (a four-string bass uses E A D G of them).
 
     ``axis`` (3,) unit from endpin toward the scroll; ``front`` (3,) unit, the
     side the strings face; ``scale_m`` the vibrating length of every string.
@@ -180,7 +186,7 @@ class UprightBass:
         return self.bridge[string] - self.pluck_from_bridge_m * self.string_dir(string)
 
     def note_of(self, string: str, fret: int) -> int:
-        """The MIDI note sounding on ``string`` stopped at ``fret``."""
+        """The MIDI note sounding on ``string`` stopped at ``fret`` (standard tuning)."""
         return OPEN_STRING_NOTES[string] + fret
 
 
@@ -274,17 +280,19 @@ def _make_bass(o: Vec) -> UprightBass:
     scale = 1.05  # 3/4 bass, 41.3 inch string length
     nut_centre = endpin + float(np.linalg.norm(nut_target - endpin)) * axis + 0.035 * front
     bridge_centre = nut_centre + scale * _unit(-axis + 0.045 * front)
-    nut_half_spacing = (-0.015, -0.005, 0.005, 0.015)  # E A D G across the nut (m)
-    bridge_half_spacing = (-0.045, -0.015, 0.015, 0.045)
+    # B E A D G C across the nut (m): E A D G 10 mm apart, B and C 9 mm outside them
+    nut_half_spacing = (-0.024, -0.015, -0.005, 0.005, 0.015, 0.024)
+    # and across the bridge: E A D G 30 mm apart, B and C 20 mm outside them
+    bridge_half_spacing = (-0.065, -0.045, -0.015, 0.015, 0.045, 0.065)
     nut = {}
     bridge = {}
-    for s, dn, db in zip(BASS_STRINGS, nut_half_spacing, bridge_half_spacing, strict=True):
+    for s, dn, db in zip(ALL_BASS_STRINGS, nut_half_spacing, bridge_half_spacing, strict=True):
         # E on the player's left (+x), G on his right; strings arch a little at the bridge
         nut[s] = nut_centre - dn * lateral
         bridge[s] = bridge_centre - db * lateral
     # the bridge points are scale_m from the nut points only up to the spacing change;
     # keep the exact scale by re-placing each bridge point along its own direction
-    for s in BASS_STRINGS:
+    for s in ALL_BASS_STRINGS:
         bridge[s] = nut[s] + scale * _unit(bridge[s] - nut[s])
     return UprightBass(
         endpin=endpin,

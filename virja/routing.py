@@ -7,10 +7,11 @@ Rules, in order (the first that decides wins), all data in
    ("bass", "drums" or "none");
 2. a channel listed in ``channels`` -> that performer;
 3. a drum channel (default MIDI channel 10, index 9) -> drums;
-4. the GM program in force on the channel is a bass (32-39) -> bass; any other
+4. the track's name reads as a bass part (``bass_track_words``) -> bass, whatever
+   its program ("Bass" with GM program 26 is still the bass part; :meth:`Router.report`
+   says so); ``names_over_programs = false`` turns this rule off;
+5. the GM program in force on the channel is a bass (32-39) -> bass; any other
    program -> nobody (a piano part never makes the bassist play chords);
-5. no program seen on the channel, and the track's name looks like a bass part
-   (``bass_track_words``) -> bass;
 6. otherwise nobody.
 
 Channels in the config are 1-based, as musicians count them; events carry
@@ -46,11 +47,19 @@ class RoutingConfig:
     bass_track_words: tuple[str, ...] = DEFAULT_BASS_WORDS
     channels: Mapping[int, Route] = field(default_factory=dict)  # 1-based channel -> route
     tracks: Mapping[str, Route] = field(default_factory=dict)  # lower-case name -> route
+    names_over_programs: bool = True  # a bass-named track is the bassist's, whatever its program
 
     @classmethod
     def from_dict(cls, table: Mapping[str, Any], where: str = "[routing]") -> RoutingConfig:
         """From the ``[routing]`` table of the config file; ``where`` names it in errors."""
-        known = {"drum_channels", "bass_programs", "bass_track_words", "channels", "tracks"}
+        known = {
+            "drum_channels",
+            "bass_programs",
+            "bass_track_words",
+            "channels",
+            "tracks",
+            "names_over_programs",
+        }
         unknown = set(table) - known
         if unknown:
             raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
@@ -75,7 +84,10 @@ class RoutingConfig:
             str(k).lower(): _target(v, f"{where}.tracks {k!r}")
             for k, v in _table_of(table, "tracks", where).items()
         }
-        return cls(drum, frozenset(progs), words, chans, tracks)
+        names_first = table.get("names_over_programs", base.names_over_programs)
+        if not isinstance(names_first, bool):
+            raise ConfigError(f"{where} names_over_programs: true or false, got {names_first!r}")
+        return cls(drum, frozenset(progs), words, chans, tracks, names_first)
 
     def with_overrides(
         self,
@@ -95,7 +107,12 @@ class RoutingConfig:
         tracks.update({n.lower(): "bass" for n in bass_tracks})
         tracks.update({n.lower(): None for n in ignore_tracks})
         return RoutingConfig(
-            self.drum_channels, self.bass_programs, self.bass_track_words, chans, tracks
+            self.drum_channels,
+            self.bass_programs,
+            self.bass_track_words,
+            chans,
+            tracks,
+            self.names_over_programs,
         )
 
 
@@ -157,6 +174,8 @@ class Router:
         self._programs: OrderedDict[tuple[int | None, int], int] = OrderedDict()
         self.programs_evicted = 0
         self.counts: Counter[tuple[int | None, int, str]] = Counter()
+        # (track, channel) -> the non-bass program a bass-named track was played over
+        self.named_over_program: dict[tuple[int | None, int], int] = {}
 
     @classmethod
     def for_session(cls, session: Any, config: RoutingConfig | None = None) -> Router:
@@ -198,12 +217,15 @@ class Router:
         if channel_1 in cfg.drum_channels:
             return "drums"
         program = self._programs.get((self._source(event), event.channel))
+        named_bass = track is not None and looks_like_bass(
+            self.track_names.get(track, ""), cfg.bass_track_words
+        )
+        if named_bass and (cfg.names_over_programs or program is None):
+            if program is not None and program not in cfg.bass_programs:
+                self.named_over_program[(track, event.channel)] = program
+            return "bass"
         if program is not None:
             return "bass" if program in cfg.bass_programs else None
-        if track is not None and looks_like_bass(
-            self.track_names.get(track, ""), cfg.bass_track_words
-        ):
-            return "bass"
         return None
 
     def report(self) -> list[str]:
@@ -217,6 +239,12 @@ class Router:
                 name = self.track_names.get(track, "")
                 where = f"track {track}" + (f" {name!r}" if name else "") + f", {where}"
             who = {"bass": "bassist", "drums": "drummer"}.get(route, "not the band's (ignored)")
+            program = self.named_over_program.get((track, channel))
+            if route == "bass" and program is not None:
+                who += (
+                    f" (named as a bass part; its GM program {program + 1} is not a bass;"
+                    " [routing] names_over_programs = false to leave it)"
+                )
             lines.append(f"{where}: {n} notes -> {who}")
         return lines
 

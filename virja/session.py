@@ -68,6 +68,9 @@ class Performance:
         self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
         self.planned_taps: list[Callable[[PlannedNote], None]] = []  # and every note committed
         self.plan_log_failed: str | None = None
+        strings = getattr(animator, "use_bass_strings", None)
+        if strings is not None:  # the bassist plays (and shows) the strings of the tuning
+            strings(tuple(name for name, _ in planner.config.bass.strings))
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""

@@ -178,8 +178,8 @@ def test_paper_experiments_through_plan_notes() -> None:
 def test_bass_paper_example_through_plan_notes() -> None:
     out = plan_notes([("bass", NoteOn(0.0, 0, 29, 100)), ("bass", NoteOn(0.5, 0, 34, 100))], T120)
     assert [(p.string, p.fret, p.motion, p.cost) for p in out] == [
-        ("E", 1, "pluck_E_fret1", 0.0),
-        ("A", 1, "pluck_A_fret1", 1.0),
+        ("E", 1, "pluck_E_fret1_pos1", 0.0),
+        ("A", 1, "pluck_A_fret1_pos1", 1.0),
     ]
 
 

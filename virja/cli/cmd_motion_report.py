@@ -57,15 +57,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--per-note", action="store_true", help="also print one line per note")
     parser.add_argument("--json", action="store_true", help="one JSON object with every figure")
+    parser.add_argument(
+        "--config", metavar="FILE.toml", help="configuration file ([plan]: the bass's tuning, ...)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     from virja.events import NoteOn
     from virja.midifile import read_midi
     from virja.motion.band import BandAnimator
+    from virja.motion.bassist_report import measure_bassist
     from virja.motion.drummer_report import measure_drummer
     from virja.motion.metrics import CONTACT_TOLERANCE_M, measure
-    from virja.plan import default_config, plan_notes_with_report
+    from virja.plan import load_plan_config, plan_notes_with_report
     from virja.routing import Router, route_all
 
     path = Path(args.input)
@@ -82,8 +86,9 @@ def run(args: argparse.Namespace) -> int:
         for who, ev in route_all(session.events, router)
         if isinstance(ev, NoteOn) and ev.time_s <= args.max_seconds
     ]
+    config = load_plan_config(args.config)
     planned, report = plan_notes_with_report(
-        notes, session.tempo_map, lookahead_beats=args.lookahead_beats
+        notes, session.tempo_map, lookahead_beats=args.lookahead_beats, config=config
     )
     if not planned:
         print(
@@ -91,12 +96,13 @@ def run(args: argparse.Namespace) -> int:
         )
         return 0
     animator = BandAnimator()
+    animator.use_bass_strings(tuple(name for name, _ in config.bass.strings))
     for beat in session.beats:
         animator.add_beat(beat)
     for p in planned:
         animator.add_planned(p)
     rep = measure(animator, planned, fps=args.fps)
-    kit = default_config().kit
+    kit = config.kit
     drummer = measure_drummer(
         animator, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=args.fps
     )
@@ -136,6 +142,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"pose time (both players): {pose_ms:.2f} ms per frame")
     for line in _drummer_table(rep, drummer, drops):
         print(line)
+    bassist = measure_bassist(animator, planned, rep)
+    if bassist is not None:
+        for line in bassist.lines():
+            print(line)
     return 0
 
 

@@ -23,8 +23,16 @@ import numpy as np
 
 from virja.errors import ConfigError
 from virja.events import Beat
-from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, DRUM_PIECES, GEOMETRY, Geometry
+from virja.geometry import (
+    ALL_BASS_STRINGS,
+    BASS_STRINGS,
+    CYMBAL_PIECES,
+    DRUM_PIECES,
+    GEOMETRY,
+    Geometry,
+)
 from virja.motion import quat
+from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
@@ -59,6 +67,9 @@ class PlannedNoteLike(Protocol):
 
     @property
     def velocity(self) -> int: ...
+
+    @property
+    def note(self) -> int: ...
 
     @property
     def limb(self) -> str: ...
@@ -102,6 +113,7 @@ class AnimationSettings:
     hihat_travel_m: float = 0.04
     string_amp_m: float = 0.004
     string_decay_s: float = 1.2
+    bassist: BassistSettings = BassistSettings()
 
     @classmethod
     def load(cls, path: Path | None = None) -> AnimationSettings:
@@ -135,6 +147,7 @@ class AnimationSettings:
                 hihat_travel_m=float(k["hihat_travel_m"]),
                 string_amp_m=float(d["strings"]["amplitude_m"]),
                 string_decay_s=float(d["strings"]["decay_s"]),
+                bassist=BassistSettings.from_table(d.get("bassist", {})),
             )
         except KeyError as exc:
             raise ConfigError(f"{where}: missing key {exc.args[0]!r}") from None
@@ -192,6 +205,19 @@ class BandAnimator:
         pedal = geometry.kit.hihat_pedal
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
+        self.bass_strings: tuple[str, ...] = BASS_STRINGS
+        self.bassist = Bassist(geometry, self.settings.bassist)
+
+    def use_bass_strings(self, strings: tuple[str, ...]) -> None:
+        """The strings of the bass's tuning, low to high (four by default; B E A D G for a
+        five-string, B E A D G C for a six-string): played, and shown in the pose."""
+        unknown = [s for s in strings if s not in ALL_BASS_STRINGS]
+        if unknown or not strings:
+            raise UnknownMotionError(
+                f"the bassist's clips cover the strings {' '.join(ALL_BASS_STRINGS)}; "
+                f"got {' '.join(strings) or 'none'}"
+            )
+        self.bass_strings = tuple(strings)
 
     # ------------------------------------------------------------------ input
 
@@ -239,11 +265,10 @@ class BandAnimator:
             )
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
         elif p.performer == "bass":
-            if p.string not in BASS_STRINGS:
+            if p.string not in self.bass_strings:
                 raise UnknownMotionError(
-                    f"the bassist's clips cover the strings {' '.join(BASS_STRINGS)}; a note "
-                    f"planned on the {p.string!r} string (a five-string or custom tuning in "
-                    "[plan]) can be planned with `virja plan` but not animated yet"
+                    f"a bass note planned on the {p.string!r} string; this bass has "
+                    f"{' '.join(self.bass_strings)} (the tuning in [plan] decides)"
                 )
             pluck = self.library[f"pluck_{p.string}"]
             self.timelines[("bass", "right_hand")].add(
@@ -266,8 +291,14 @@ class BandAnimator:
                 if current and current[-1].clip.string == p.string:
                     left.add(self._hold("fret_open", p))
             self._add_hit(Hit(p.impact, p.string, p.velocity))
+            self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity, p.start)
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
+
+    def note_off(self, performer: str, event: Any) -> None:
+        """A note-off: the bassist's fingers lift from the string (an open string rings on)."""
+        if performer == "bass":
+            self.bassist.note_off(int(event.note), float(event.time_s))
 
     def _hold(self, name: str, p: PlannedNoteLike) -> Instance:
         # a hold with no predecessor fades in from the rest pose over its preparation
@@ -285,6 +316,7 @@ class BandAnimator:
         for tl in self.timelines.values():
             tl.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
+        self.bassist.forget_before(horizon)
         k = bisect.bisect_left(self._hit_times, horizon)
         del self._hits[:k]
         del self._hit_times[:k]
@@ -308,7 +340,20 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
+        index, phase = self._beat_phase(time_s)
+        out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
+
+    def _beat_phase(self, t: float) -> tuple[int, float]:
+        """(beat number, phase 0..1 within it) at ``t`` (120 bpm before the first beat)."""
+        i = bisect.bisect_right(self._beat_times, t) - 1
+        if i >= 0:
+            phase = (t - self._beat_times[i]) / self._beat_spb[i]
+            if phase < 1.0:
+                return i, phase
+            return i + int(phase), phase % 1.0
+        spb = self.settings.reference_spb
+        return int(math.floor(t / spb)), (t / spb) % 1.0
 
     def _nod(self, t: float) -> np.ndarray:
         s = self.settings
@@ -346,6 +391,7 @@ class BandAnimator:
             string_stops=self._stops(time_s),
             fretting_tip=wpos[1, _SK.index("LeftHandEnd")].copy(),
             plucking_tip=wpos[1, _SK.index("RightHandEnd")].copy(),
+            bass_fingers=self.bassist.fingers(time_s, wpos[1]),
         )
 
     def local_rotations_many(self, times: np.ndarray) -> np.ndarray:
@@ -369,6 +415,9 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
+        for k, t in enumerate(ts.tolist()):  # the bassist's body: per frame (IK, not batched)
+            index, phase = self._beat_phase(t)
+            out[k, 1] = self.bassist.body(out[k, 1], self._roots[1], t, phase, index)
         return out
 
     def _nod_many(self, t: np.ndarray) -> np.ndarray:
@@ -418,6 +467,7 @@ class BandAnimator:
                     string_stops=self._stops(t),
                     fretting_tip=p[1, _SK.index("LeftHandEnd")].copy(),
                     plucking_tip=p[1, _SK.index("RightHandEnd")].copy(),
+                    bass_fingers=self.bassist.fingers(t, p[1]),
                 )
             )
         return out
@@ -458,7 +508,7 @@ class BandAnimator:
         return out
 
     def _strings(self, t: float) -> dict[str, float]:
-        out = dict.fromkeys(BASS_STRINGS, 0.0)
+        out = dict.fromkeys(self.bass_strings, 0.0)
         s = self.settings
         latest: dict[str, Hit] = {}
         for h in self._recent(t, 8 * s.string_decay_s):
@@ -471,7 +521,7 @@ class BandAnimator:
         return out
 
     def _stops(self, t: float) -> dict[str, int]:
-        out = dict.fromkeys(BASS_STRINGS, 0)
+        out = dict.fromkeys(self.bass_strings, 0)
         act = self.timelines[("bass", "left_hand")].active(t)
         for inst in reversed(act):
             if inst.impact <= t:

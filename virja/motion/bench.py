@@ -25,6 +25,7 @@ class _Note:
         self.time = impact
         self.performer = performer
         self.velocity = 90
+        self.note = 40
         self.limb = limb
         self.piece = piece
         self.string = string

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from virja.errors import InputFileError, VirjaError
-from virja.geometry import BASS_STRINGS, PIECES
+from virja.geometry import ALL_BASS_STRINGS, PIECES
 from virja.motion.bvh import Bvh, read_bvh
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON, Skeleton
 
@@ -197,9 +197,9 @@ def read_sidecar(path: Path) -> dict[str, Any]:
     if piece is not None and piece not in PIECES:
         raise _fail(path, text, "piece", f"unknown piece {piece!r}; expected one of {PIECES}")
     string = data.get("string")
-    if string is not None and string not in BASS_STRINGS:
+    if string is not None and string not in ALL_BASS_STRINGS:
         raise _fail(
-            path, text, "string", f"unknown string {string!r}; expected one of {BASS_STRINGS}"
+            path, text, "string", f"unknown string {string!r}; expected one of {ALL_BASS_STRINGS}"
         )
     fret = data.get("fret")
     if fret is not None and (

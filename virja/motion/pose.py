@@ -8,9 +8,11 @@ read-only by the consumer.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+
+LEFT_FINGER_BONES = 10  # the fretting hand's bones in ``BandPose.bass_fingers``
 
 
 @dataclass(frozen=True)
@@ -53,7 +55,12 @@ class BandPose:
       metres at the middle of the vibrating part, decaying after a pluck;
     - ``string_stops``: string -> fret stopped now (0 = open);
     - ``fretting_tip``: (3,) the bassist's left (fretting) fingertip, metres;
-    - ``plucking_tip``: (3,) the bassist's right (plucking) fingertip, metres.
+    - ``plucking_tip``: (3,) the bassist's right (plucking) fingertip, metres;
+    - ``bass_fingers``: (k, 2, 3) the bassist's finger bones (from, to), metres
+      (:mod:`virja.motion.bassist`; empty when not drawn): the fretting hand's
+      first (:data:`LEFT_FINGER_BONES`: index, middle, ring, little, two bones
+      each, then the thumb's two), then the plucking hand's (index, middle, two
+      bones each, ring and little curled, the thumb).
     """
 
     time_s: float
@@ -67,6 +74,7 @@ class BandPose:
     string_stops: Mapping[str, int]
     fretting_tip: np.ndarray
     plucking_tip: np.ndarray
+    bass_fingers: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
 
     def figure(self, performer: str) -> FigurePose:
         """``"drums"`` or ``"bass"``."""

@@ -1,35 +1,63 @@
-"""The bassist: which string and fret for each note, by least total finger travel.
+"""The bassist: which string and fret for each note, and where the left hand is.
 
-State is the left hand's stopping finger, ``(string index, fret)``, or None
-before the first stopped note.  Cost of the next basic motion from state
-``(s0, f0)`` (docs/scheduler.md):
+State is the left hand: ``(string, fret, position)`` of the last stopping
+finger and the hand's position (the fret under the first finger), or None
+before the first stopped note.  The position covers ``span(position)`` frets
+above it (:class:`~virja.plan.config.Fingering`: a whole tone with 1-2-4
+fingering in the lower positions, wider in thumb position).  Cost of the next
+basic motion from ``(s0, f0, h0)`` (docs/scheduler.md):
 
-- a stopped note at ``(s, f)``, ``f >= 1``: ``|f - f0| + |s - s0|``; the finger
-  moves there;
-- an open string ``s``: ``|s - s0|`` (0 on the finger's own string); the finger
-  stays where it was (the hand does not jump to fret 0);
-- from None, anything costs 0.
+- the paper's finger travel, the base: a stopped note at ``(s, f)`` costs
+  ``|f - f0| + |s - s0|``; an open string ``s`` costs ``|s - s0|`` and leaves
+  the hand where it is;
+- no shift while the stopped frets lie in the span of ``h0``; otherwise the
+  hand shifts to a position ``h`` that covers them, for ``shift_cost +
+  shift_cost_per_fret * |h - h0|``, plus ``rushed_shift_cost`` when the time
+  since the previous note is shorter than the shift takes
+  (``shift_time(|h - h0|)``);
+- every stopped note pays ``position_cost_per_fret * (h - 1)``: lower positions
+  are preferred;
+- from None, a stopped note pays only its position cost.
 
-A double stop costs the move to its *anchor*: the melody (higher) note's stop
-when stopped, else the other note's stop, else (both open) like an open melody
-note.  Least total cost is found by dynamic programming over finger positions
-(Viterbi), not greedily.
+The paper's example holds: F1 on E fret 1 (position 1), then B-flat1 on A fret
+1 costs 1 (E fret 6 costs 5 + a shift).  A double stop costs the move to its
+*anchor*: the melody (higher) note's stop when stopped, else the other note's
+stop, else (both open) like an open melody note; its position covers both
+stops where one can.  Least total cost is found by dynamic programming over
+hand states (Viterbi), not greedily.
 """
 
 from __future__ import annotations
 
 import functools
 import logging
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from virja.plan.config import BassSetup
+from virja.plan.config import BassSetup, Fingering
 
 log = logging.getLogger(__name__)
 
 Position = tuple[int, int]  # (string index low to high, fret; 0 = open)
-BassState = Position | None  # the stopping finger (never an open string)
+HandState = tuple[int, int, int]  # (string, fret) of the stopping finger, hand position
+BassState = HandState | None  # the left hand (never on an open string)
 BassOption = tuple[Position, ...]  # one position per kept note, melody first
+
+DEFAULT_FINGERING = Fingering()
+
+
+def motion_name(string: str, fret: int, hand: BassState) -> str:
+    """The basic motion's name: ``pluck_<string>_fret<fret>``, and ``_pos<position>``
+    of the left hand once it has one (an open string keeps the hand where it was)."""
+    base = f"pluck_{string}_fret{fret}"
+    return base if hand is None else f"{base}_pos{hand[2]}"
+
+
+def position_of(motion: str) -> int | None:
+    """The hand position a bass motion name carries (None if it carries none)."""
+    _, sep, tail = motion.rpartition("_pos")
+    return int(tail) if sep and tail.isdigit() else None
 
 
 def fold_into_range(setup: BassSetup, note: int) -> int:
@@ -90,61 +118,156 @@ def anchor(option: BassOption) -> Position | None:
     return None
 
 
-def transition(state: BassState, option: BassOption) -> tuple[float, BassState]:
-    """Cost of playing ``option`` from ``state``, and the finger's state after it."""
+@functools.lru_cache(maxsize=4096)
+def hand_positions(fingering: Fingering, low: int, high: int) -> tuple[int, ...]:
+    """Positions whose span covers frets ``low..high`` (lowest first); if none can,
+    those covering ``high`` alone (a stretch for the other finger)."""
+    widest = max(fingering.span_frets, fingering.thumb_span_frets)
+    out = tuple(h for h in range(max(1, high - widest), low + 1) if high <= h + fingering.span(h))
+    if out or low == high:
+        return out
+    return hand_positions(fingering, high, high)
+
+
+def _stops(option: BassOption) -> tuple[int, int] | None:
+    frets = [f for _, f in option if f > 0]
+    return (min(frets), max(frets)) if frets else None
+
+
+def transitions(
+    state: BassState,
+    option: BassOption,
+    fingering: Fingering = DEFAULT_FINGERING,
+    gap_s: float = math.inf,
+) -> list[tuple[float, BassState]]:
+    """Every way to play ``option`` from ``state``: ``(cost, hand state after)``, one
+    per hand position it may be played in (one when no shift is needed).
+    ``gap_s`` is the time since the previous note (a shift needs time)."""
     a = anchor(option)
-    if state is None:
-        return 0.0, a
     if a is None:
-        return float(abs(option[0][0] - state[0])), state
-    return float(abs(a[1] - state[1]) + abs(a[0] - state[0])), a
+        if state is None:
+            return [(0.0, None)]
+        return [(float(abs(option[0][0] - state[0])), state)]
+    low, high = _stops(option) or (a[1], a[1])
+    per = fingering.position_cost_per_fret
+    if state is None:
+        return [(per * (h - 1), (a[0], a[1], h)) for h in hand_positions(fingering, low, high)]
+    s0, f0, h0 = state
+    base = float(abs(a[1] - f0) + abs(a[0] - s0))
+    if h0 <= low and high <= h0 + fingering.span(h0):
+        return [(base + per * (h0 - 1), (a[0], a[1], h0))]
+    out: list[tuple[float, BassState]] = []
+    for h in hand_positions(fingering, low, high):
+        d = abs(h - h0)
+        c = base + fingering.shift_cost + fingering.shift_cost_per_fret * d + per * (h - 1)
+        if gap_s < fingering.shift_time(d):
+            c += fingering.rushed_shift_cost
+        out.append((c, (a[0], a[1], h)))
+    return out
 
 
-def path_cost(state: BassState, options: Sequence[BassOption]) -> float:
-    """Total cost of playing ``options`` in order from ``state`` (the definition)."""
-    total = 0.0
-    for opt in options:
-        c, state = transition(state, opt)
-        total += c
-    return total
+def transition(
+    state: BassState,
+    option: BassOption,
+    fingering: Fingering = DEFAULT_FINGERING,
+    gap_s: float = math.inf,
+) -> tuple[float, BassState]:
+    """The cheapest of :func:`transitions` (the lower position on a tie)."""
+    return min(transitions(state, option, fingering, gap_s), key=lambda t: t[0])
+
+
+def shifted(before: BassState, after: BassState) -> bool:
+    """Whether the hand changed position between two states."""
+    return before is not None and after is not None and before[2] != after[2]
+
+
+def path_cost(
+    state: BassState,
+    options: Sequence[BassOption],
+    fingering: Fingering = DEFAULT_FINGERING,
+    gaps: Sequence[float] | None = None,
+) -> float:
+    """Least total cost of playing ``options`` in order from ``state``, over every
+    choice of hand position (the definition, by exhaustive search: for tests)."""
+    if not options:
+        return 0.0
+    gap = math.inf if gaps is None else gaps[0]
+    rest = None if gaps is None else gaps[1:]
+    return min(
+        c + path_cost(new, options[1:], fingering, rest)
+        for c, new in transitions(state, options[0], fingering, gap)
+    )
 
 
 @dataclass(frozen=True)
 class BassSolution:
     choice: tuple[int, ...]  # option index per group
     costs: tuple[float, ...]  # cost paid by each group
-    states: tuple[BassState, ...]  # finger state after each group
+    states: tuple[BassState, ...]  # hand state after each group
     total: float
 
 
-def solve(state: BassState, groups: Sequence[Sequence[BassOption]]) -> BassSolution:
-    """Least-total-cost option per group from ``state`` (Viterbi over finger states).
+def solve(
+    state: BassState,
+    groups: Sequence[Sequence[BassOption]],
+    fingering: Fingering = DEFAULT_FINGERING,
+    gaps: Sequence[float] | None = None,
+) -> BassSolution:
+    """Least-total-cost option per group from ``state`` (Viterbi over hand states).
 
-    Ties go to the earlier option (open strings and low frets first) and,
-    among end states, to the first reached.
+    ``gaps[i]`` is the time from the previous note to group ``i`` (inf: unknown).
+    Ties go to the earlier option (open strings and low frets first), then the
+    lower hand position and, among end states, to the first reached.
     """
     best: dict[BassState, float] = {state: 0.0}
     backs: list[dict[BassState, tuple[BassState, int, float]]] = []
-    for options in groups:
-        # :func:`transition` inlined, with each option's anchor found once per group
-        # instead of once per state (same arithmetic, same order, same results)
-        prepared = [(anchor(opt), opt[0][0]) for opt in options]
+    per = fingering.position_cost_per_fret
+    span = fingering.span
+    for gi, options in enumerate(groups):
+        gap = math.inf if gaps is None else gaps[gi]
+        # :func:`transitions` inlined, with what does not depend on the previous state
+        # worked out once per group (same arithmetic, same order, same results)
+        prepared: list[tuple[Position | None, int, int, int, tuple[int, ...]]] = []
+        for opt in options:
+            a = anchor(opt)
+            if a is None:
+                prepared.append((a, opt[0][0], 0, 0, ()))
+                continue
+            low, high = _stops(opt) or (a[1], a[1])
+            prepared.append((a, opt[0][0], low, high, hand_positions(fingering, low, high)))
         nxt: dict[BassState, float] = {}
         back: dict[BassState, tuple[BassState, int, float]] = {}
         for prev, acc in best.items():
-            for k, (a, melody_string) in enumerate(prepared):
-                new: BassState
-                if prev is None:
-                    c, new = 0.0, a
-                elif a is None:
-                    c, new = float(abs(melody_string - prev[0])), prev
+            for k, (a, melody, low, high, hs) in enumerate(prepared):
+                moves: list[tuple[float, BassState]]
+                if a is None:
+                    moves = [(0.0 if prev is None else float(abs(melody - prev[0])), prev)]
+                elif prev is None:
+                    moves = [(per * (h - 1), (a[0], a[1], h)) for h in hs]
                 else:
-                    c, new = float(abs(a[1] - prev[1]) + abs(a[0] - prev[0])), a
-                total = acc + c
-                old = nxt.get(new)
-                if old is None or total < old:
-                    nxt[new] = total
-                    back[new] = (prev, k, c)
+                    s0, f0, h0 = prev
+                    base = float(abs(a[1] - f0) + abs(a[0] - s0))
+                    if h0 <= low and high <= h0 + span(h0):
+                        moves = [(base + per * (h0 - 1), (a[0], a[1], h0))]
+                    else:
+                        moves = []
+                        for h in hs:
+                            d = abs(h - h0)
+                            c = (
+                                base
+                                + fingering.shift_cost
+                                + fingering.shift_cost_per_fret * d
+                                + per * (h - 1)
+                            )
+                            if gap < fingering.shift_time(d):
+                                c += fingering.rushed_shift_cost
+                            moves.append((c, (a[0], a[1], h)))
+                for c, new in moves:
+                    total = acc + c
+                    old = nxt.get(new)
+                    if old is None or total < old:
+                        nxt[new] = total
+                        back[new] = (prev, k, c)
         best = nxt
         backs.append(back)
     end = min(best, key=lambda s: best[s])

@@ -109,12 +109,57 @@ def _need(data: dict[str, Any], where: str, key: str, prefix: str = "") -> Any:
 
 
 @dataclass(frozen=True)
+class Fingering:
+    """How the left hand covers the fingerboard (``[fingering]`` of motions/bass.toml).
+
+    A hand *position* is the fret under the first finger (the thumb in thumb
+    position); it covers ``span_frets`` frets above that (1-2-4 fingering: a whole
+    tone) below ``thumb_position_fret``, ``thumb_span_frets`` from there on.
+    Costs are in the paper's unit (one fret or one string of finger travel).
+    """
+
+    span_frets: int = 2
+    thumb_position_fret: int = 12
+    thumb_span_frets: int = 3
+    shift_cost: float = 2.0
+    shift_cost_per_fret: float = 0.5
+    position_cost_per_fret: float = 0.1
+    shift_time_s: float = 0.06
+    shift_time_per_fret_s: float = 0.012
+    rushed_shift_cost: float = 4.0
+
+    def __post_init__(self) -> None:
+        for key in ("span_frets", "thumb_position_fret", "thumb_span_frets"):
+            if getattr(self, key) < 0:
+                raise ConfigError(f"fingering {key} must be >= 0, got {getattr(self, key)}")
+        for key in (
+            "shift_cost",
+            "shift_cost_per_fret",
+            "position_cost_per_fret",
+            "shift_time_s",
+            "shift_time_per_fret_s",
+            "rushed_shift_cost",
+        ):
+            if not getattr(self, key) >= 0:
+                raise ConfigError(f"fingering {key} must be >= 0, got {getattr(self, key)}")
+
+    def span(self, position: int) -> int:
+        """Frets covered above ``position`` without a shift."""
+        return self.thumb_span_frets if position >= self.thumb_position_fret else self.span_frets
+
+    def shift_time(self, frets: int) -> float:
+        """Seconds a shift of the hand by ``frets`` takes."""
+        return self.shift_time_s + self.shift_time_per_fret_s * frets
+
+
+@dataclass(frozen=True)
 class BassSetup:
     """The bass: ``strings`` low to high as (name, open MIDI note)."""
 
     strings: tuple[tuple[str, int], ...]
     frets: int
     double_stop_span_frets: int
+    fingering: Fingering = Fingering()
 
     def __post_init__(self) -> None:
         if not self.strings:
@@ -265,7 +310,26 @@ def parse_bass(
         strings,
         _int(_need(data, where, "frets"), where, "frets"),
         _int(_need(data, where, "double_stop_span_frets"), where, "double_stop_span_frets"),
+        parse_fingering(_table(data.get("fingering", {}), where, "fingering"), where),
     )
+
+
+def parse_fingering(data: dict[str, Any], where: str) -> Fingering:
+    """The ``[fingering]`` table; keys left out keep :class:`Fingering`'s defaults."""
+    ints = ("span_frets", "thumb_position_fret", "thumb_span_frets")
+    floats = (
+        "shift_cost",
+        "shift_cost_per_fret",
+        "position_cost_per_fret",
+        "shift_time_s",
+        "shift_time_per_fret_s",
+        "rushed_shift_cost",
+    )
+    if unknown := sorted(set(data) - set(ints) - set(floats)):
+        raise ConfigError(f"{where}: unknown key(s) in [fingering]: {', '.join(unknown)}")
+    kw: dict[str, Any] = {k: _int(data[k], where, f"fingering.{k}") for k in ints if k in data}
+    kw.update({k: _float(data[k], where, f"fingering.{k}") for k in floats if k in data})
+    return Fingering(**kw)
 
 
 def parse_strings(value: object, where: str, key: str) -> tuple[tuple[str, int], ...]:
@@ -432,6 +496,7 @@ def plan_config_from_table(
             where,
             "double_stop_span_frets",
         ),
+        bass.fingering,
     )
     kit, kit_where = table("drum_kit", "drum_kit.toml")
     costs, costs_where = table("drum_costs", "drum_costs.toml")

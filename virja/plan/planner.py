@@ -351,12 +351,20 @@ class OnlinePlanner:
         for gi in range(n_groups):
             kept, opts = self._bass_group(groups[gi])
             if not chain.plan:  # none yet, or the window's plan is used up: solve the next
+                win = groups[gi : gi + window]
+                times = [g[0].note.time_s for g in win]
+                last = groups[gi - 1][0].note.time_s if gi > 0 else chain.last_fixed_t
+                gaps = [times[0] - last if last is not None else math.inf]
+                gaps += [b - a for a, b in zip(times, times[1:], strict=False)]
                 sol = bass_mod.solve(
-                    chain.state, [self._bass_group(g)[1] for g in groups[gi : gi + window]]
+                    chain.state,
+                    [self._bass_group(g)[1] for g in win],
+                    self.config.bass.fingering,
+                    gaps,
                 )
                 chain.plan = list(zip(sol.choice, sol.costs, sol.states, strict=True))
             choice, cost, state = chain.plan.pop(0)
-            self._emit_bass_group(chain, groups[gi], kept, opts[choice], cost)
+            self._emit_bass_group(chain, groups[gi], kept, opts[choice], cost, state)
             chain.state = state
 
     def _emit_bass_group(
@@ -366,6 +374,7 @@ class OnlinePlanner:
         kept: list[int],
         option: bass_mod.BassOption,
         cost: float,
+        hand: bass_mod.BassState,
     ) -> None:
         where = dict(zip(kept, option, strict=True))
         paid = False
@@ -382,7 +391,7 @@ class OnlinePlanner:
                 piece=None,
                 string=name,
                 fret=f,
-                motion=f"pluck_{name}_fret{f}",
+                motion=bass_mod.motion_name(name, f, hand),
                 cost=0.0 if paid else cost,
             )
             paid = True
@@ -689,9 +698,10 @@ class OnlinePlanner:
                 self._drop(rec, "no_double_stop")
             else:
                 opts = [(p,) for p in bass_mod.positions(self.config.bass, rec.played)]
-                best = min(opts, key=lambda o: bass_mod.transition(chain.state, o)[0])
-                cost = bass_mod.transition(chain.state, best)[0]
-                self._emit_bass_group(chain, [rec], [rec.played], best, cost)
+                fingering = self.config.bass.fingering
+                best = min(opts, key=lambda o: bass_mod.transition(chain.state, o, fingering)[0])
+                cost, after = bass_mod.transition(chain.state, best, fingering)
+                self._emit_bass_group(chain, [rec], [rec.played], best, cost, after)
             return
         assert rec.drum is not None
         piece = rec.drum.piece

@@ -70,6 +70,9 @@ PRESETS: dict[str, Camera] = {
     # from the audience's right, where the bass's strings face past the player
     "bass": Camera(target=(0.95, 1.05, 0.15), yaw_deg=20.0, pitch_deg=10.0, distance_m=2.5),
     "top": Camera(pitch_deg=70.0, distance_m=6.0),
+    # close-ups of the bassist's hands: the fretting hand on the neck, the plucking hand
+    "bass_left": Camera(target=(1.08, 1.45, 0.15), yaw_deg=-10.0, pitch_deg=5.0, distance_m=0.8),
+    "bass_right": Camera(target=(1.0, 1.0, 0.25), yaw_deg=-25.0, pitch_deg=15.0, distance_m=0.8),
 }
 
 

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
-from virja.motion.pose import BandPose, FigurePose
+from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
+from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
     box_transforms,
     disc_transforms,
@@ -167,10 +167,16 @@ def _bass_static(dl: DrawList, geo: Geometry) -> None:
     )
     dl.add("sphere", sphere_transforms([nut_c + 0.10 * up - 0.02 * b.front], 0.05), WOOD)
     # fingerboard: a long thin box from the nut down past the neck joint
+    # (along the strings, which rise off the neck toward the bridge: its face stays 4 mm
+    # behind them from the nut down)
     fb_end = nut_c + 0.78 * (bridge_c - nut_c)
-    mid = (nut_c + fb_end) / 2 - 0.008 * b.front
+    along = (fb_end - nut_c) / np.linalg.norm(fb_end - nut_c)
+    face = b.front - np.dot(b.front, along) * along
+    face /= np.linalg.norm(face)
+    board = np.stack([np.cross(along, face), along, face], axis=1)
+    mid = (nut_c + fb_end) / 2 - 0.011 * face
     length = float(np.linalg.norm(fb_end - nut_c))
-    dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], _orient(b)[None]), EBONY)
+    dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], board[None]), EBONY)
     # bridge and tailpiece
     dl.add(
         "box",
@@ -200,7 +206,13 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     _kit_dynamic(dl, geo, pose)
     _strings(dl, geo, pose)
     _figure(dl, pose.drums, DRUMMER_SHIRT)
-    _figure(dl, pose.bass, BASSIST_SHIRT)
+    fingers = np.asarray(pose.bass_fingers, dtype=np.float64).reshape(-1, 2, 3)
+    if len(fingers):
+        # fingers instead of the one-piece hands: a palm to the knuckles, two bones a finger
+        _figure(dl, pose.bass, BASSIST_SHIRT, skip=("LeftHandEnd", "RightHandEnd"))
+        _fingers(dl, pose.bass, fingers)
+    else:
+        _figure(dl, pose.bass, BASSIST_SHIRT)
     s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
     dl.add("cylinder", segment_transforms(s[:, 0], s[:, 1], 0.0075), STICK)
     dl.add("sphere", sphere_transforms(s[:, 1], 0.009), STICK)
@@ -256,11 +268,15 @@ def _rotate(v: F64, axis: F64, angle: float) -> F64:
 
 
 def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) -> None:
-    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge."""
+    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge.
+
+    The strings drawn are the pose's (the tuning's: four, five or six)."""
     b = geo.bass
     lateral = np.cross(b.axis, b.front)
     lateral /= np.linalg.norm(lateral)
-    for k, s in enumerate(b.strings):
+    drawn = [s for s in b.strings if s in pose.string_vibration] or list(BASS_STRINGS)
+    for s in drawn:
+        k = b.strings.index(s) - b.strings.index("E")  # thinner from the E string up
         a, z = b.nut[s], b.bridge[s]
         amp = float(pose.string_vibration.get(s, 0.0))
         radius = 0.0022 - 0.0003 * k
@@ -278,12 +294,30 @@ def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) ->
         dl.add("cylinder", segment_transforms(pts[:-1], pts[1:], radius * 1.3), STRING_HOT)
 
 
-def _figure(dl: DrawList, fig: FigurePose, shirt: tuple[float, ...]) -> None:
+def _fingers(dl: DrawList, fig: FigurePose, bones: F64) -> None:
+    """The bassist's finger bones (k, 2, 3) with a palm from each wrist to its knuckles."""
+    names = list(fig.names)
+    pos = np.asarray(fig.positions, dtype=np.float64)
+    half = LEFT_FINGER_BONES
+    for wrist, knuckles in (
+        ("LeftHand", bones[:8:2, 0]),
+        ("RightHand", bones[half : half + 4 : 2, 0]),
+    ):
+        if len(knuckles):
+            w = pos[names.index(wrist)]
+            dl.add("cylinder", segment_transforms([w], [knuckles.mean(axis=0)], 0.022), SKIN)
+    dl.add("cylinder", segment_transforms(bones[:, 0], bones[:, 1], 0.0075), SKIN)
+    dl.add("sphere", sphere_transforms(bones[:, 1], 0.008), SKIN)
+
+
+def _figure(
+    dl: DrawList, fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ...] = ()
+) -> None:
     pos = np.asarray(fig.positions, dtype=np.float64)
     parents = np.asarray(fig.parents)
     radii = np.asarray(fig.radii, dtype=np.float64)
     names = list(fig.names)
-    is_head = np.array([n.lower() in ("head", "headend") for n in names])
+    is_head = np.array([n.lower() in ("head", "headend") or n in skip for n in names])
     child = np.nonzero((parents >= 0) & ~is_head)[0]
     colors = np.array([_limb_color(names[i], shirt) for i in child])
     dl.add("cylinder", segment_transforms(pos[parents[child]], pos[child], radii[child]), colors)

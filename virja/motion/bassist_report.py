@@ -1,0 +1,237 @@
+"""The bassist's figures for ``virja motion-report`` (docs/motion.md).
+
+Sampled from the animator at 30 fps (what a viewer sees) and 120 fps (speeds):
+
+- **contact / timing** at impact of the bass notes (from :func:`virja.motion.metrics.measure`);
+- **wrist speed** p99 and max (m/s), both wrists, 120 fps;
+- **largest jump** (m): the largest move of any of the bassist's joints or
+  fingertips from one 30 fps frame to the next;
+- **torso range** (degrees): the largest angle between the chest's orientations
+  at any two frames;
+- **collisions**: frames where the centre line of a hand or forearm passes
+  through the fingerboard (a 7 cm x 1.4 cm board behind the strings, nut to its
+  end) or the bass's body (the ellipsoids drawn);
+- **fretting hand on the correct side** (share of frames): the left wrist on
+  the E side of the fingerboard (the side the arm comes from, thumb behind the
+  neck), not in front of the strings by more than 2 cm, and the elbow behind
+  the strings;
+- **shifts per stopped note**: how often the hand position (``_pos`` in the
+  motion name) changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from virja.motion import quat
+from virja.motion.band import BandAnimator, PlannedNoteLike
+from virja.motion.bassist import position_of
+from virja.motion.metrics import MotionReport
+from virja.motion.skeleton import SKELETON
+
+_SK = SKELETON
+BOARD_HALF_WIDTH_M = 0.035
+BOARD_FACE_M = -0.004  # the fingerboard's face, behind the strings (render.scene)
+BOARD_BACK_M = -0.030  # the neck's back
+SEGMENTS = (
+    ("LeftForeArm", "LeftHand"),
+    ("LeftHand", "LeftHandEnd"),
+    ("RightForeArm", "RightHand"),
+    ("RightHand", "RightHandEnd"),
+)
+
+# targets (issue 16, as for the drummer where they apply)
+TARGETS = {
+    "contact_mm": 10.0,
+    "timing_ms": 0.0,
+    "wrist_p99": 5.0,
+    "wrist_max": 8.0,
+    "jump_cm": 15.0,
+    "torso_deg": 3.0,
+    "collisions": 0,
+    "side_share": 1.0,
+}
+
+
+@dataclass(frozen=True)
+class BassistFigures:
+    notes: int
+    contact_max_m: float
+    contacts_over: int
+    timing_max_s: float
+    wrist_p99: float
+    wrist_max: float
+    jump_max_m: float
+    torso_range_deg: float
+    collision_frames: int
+    frames: int
+    side_share: float
+    shifts: int
+    stopped: int
+
+    def lines(self) -> list[str]:
+        """The report, one figure a line with its target and OK/MISS."""
+
+        def ok(good: bool) -> str:
+            return "ok" if good else "MISS"
+
+        t = TARGETS
+        per = self.shifts / self.stopped if self.stopped else 0.0
+        return [
+            f"bassist: {self.notes} notes, {self.frames} frames at 30 fps",
+            f"  contact at impact: max {self.contact_max_m * 1e3:.2f} mm, "
+            f"{self.contacts_over} over 10 mm  [target < {t['contact_mm']:.0f} mm: "
+            f"{ok(self.contacts_over == 0)}]",
+            f"  timing at impact: max {self.timing_max_s * 1e3:.1f} ms  "
+            f"[target 0 ms: {ok(self.timing_max_s <= 0.0005)}]",
+            f"  wrist speed: p99 {self.wrist_p99:.2f} m/s, max {self.wrist_max:.2f} m/s  "
+            f"[targets <= {t['wrist_p99']:.0f} / {t['wrist_max']:.0f}: "
+            f"{ok(self.wrist_p99 <= t['wrist_p99'] and self.wrist_max <= t['wrist_max'])}]",
+            f"  largest jump between 30 fps frames: {self.jump_max_m * 100:.1f} cm  "
+            f"[target <= {t['jump_cm']:.0f} cm: {ok(self.jump_max_m * 100 <= t['jump_cm'])}]",
+            f"  torso range: {self.torso_range_deg:.1f} deg  "
+            f"[target >= {t['torso_deg']:.0f}: {ok(self.torso_range_deg >= t['torso_deg'])}]",
+            f"  collisions (hands, forearms vs fingerboard and body): {self.collision_frames} "
+            f"frames  [target 0: {ok(self.collision_frames == 0)}]",
+            f"  fretting hand on the correct side: {self.side_share * 100:.1f} % of frames  "
+            f"[target 100 %: {ok(self.side_share >= 1.0)}]",
+            f"  hand shifts: {self.shifts} for {self.stopped} stopped notes ({per:.2f} per note)",
+        ]
+
+    @property
+    def meets_targets(self) -> bool:
+        t = TARGETS
+        return (
+            self.contacts_over == 0
+            and self.timing_max_s <= 0.0005
+            and self.wrist_p99 <= t["wrist_p99"]
+            and self.wrist_max <= t["wrist_max"]
+            and self.jump_max_m * 100 <= t["jump_cm"]
+            and self.torso_range_deg >= t["torso_deg"]
+            and self.collision_frames == 0
+            and self.side_share >= 1.0
+        )
+
+
+def _frames(animator: BandAnimator, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(k, n, 3) bassist joint positions, (k, n, 4) rotations, (k, m, 3) finger points."""
+    pos, rot, fingers = [], [], []
+    for t in times:
+        pose = animator.pose(float(t))
+        pos.append(pose.bass.positions)
+        rot.append(pose.bass.rotations)
+        fingers.append(pose.bass_fingers.reshape(-1, 3))
+    return np.array(pos), np.array(rot), np.array(fingers)
+
+
+def _neck_frame(
+    animator: BandAnimator,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """(nut centre, along the strings, lateral toward E, out of the board face, board
+    length): the fingerboard as render.scene draws it, along the strings."""
+    b = animator.geometry.bass
+    nut = np.mean([b.nut[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
+    bridge = np.mean([b.bridge[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
+    along = bridge - nut
+    length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
+    along = along / np.linalg.norm(along)
+    face = b.front - np.dot(b.front, along) * along
+    face = face / np.linalg.norm(face)
+    return nut, along, np.cross(face, along), face, length  # lateral: + toward E
+
+
+def _in_board(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
+    """Which points (..., 3) lie inside the fingerboard and the neck behind it."""
+    nut, along, lateral, face, length = _neck_frame(animator)
+    rel = points - nut
+    u = rel @ along
+    lat = rel @ lateral
+    fr = rel @ face
+    return (
+        (u > 0.0)
+        & (u < length)
+        & (np.abs(lat) < BOARD_HALF_WIDTH_M)
+        & (fr < BOARD_FACE_M)
+        & (fr > BOARD_BACK_M)
+    )
+
+
+def _in_body(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
+    b = animator.geometry.bass
+    up = b.axis
+    lateral = np.cross(b.axis, b.front)
+    lateral /= np.linalg.norm(lateral)
+    inside = np.zeros(points.shape[:-1], dtype=bool)
+    for c, s in (
+        (b.body_centre - 0.22 * up, (b.body_width / 2, 0.34, b.body_depth / 2)),
+        (b.body_centre + 0.28 * up, (b.body_width / 2 * 0.8, 0.26, b.body_depth / 2)),
+    ):
+        rel = points - c
+        q = (rel @ lateral / s[0]) ** 2 + (rel @ up / s[1]) ** 2 + (rel @ b.front / s[2]) ** 2
+        inside |= q < 1.0
+    return inside
+
+
+def measure_bassist(
+    animator: BandAnimator, planned: Sequence[PlannedNoteLike], report: MotionReport
+) -> BassistFigures | None:
+    """The bassist's figures for ``planned`` (added to ``animator``); None without bass notes."""
+    bass = [p for p in planned if p.performer == "bass"]
+    if not bass:
+        return None
+    checks = [c for c in report.notes if c.motion.startswith("pluck_")]
+    contacts = [c.contact_m for c in checks] + [
+        c.fret_contact_m for c in checks if c.fret_contact_m is not None
+    ]
+    t0 = min(p.start for p in bass)
+    t1 = max(p.impact for p in bass) + 0.6
+    fast = t0 + np.arange(int((t1 - t0) * 120) + 1) / 120.0
+    pos120, _, _ = _frames(animator, fast)
+    wrists = pos120[:, [_SK.index("LeftHand"), _SK.index("RightHand")]]
+    speed = np.linalg.norm(np.diff(wrists, axis=0), axis=-1).ravel() * 120.0
+    slow = t0 + np.arange(int((t1 - t0) * 30) + 1) / 30.0
+    pos, rot, fingers = _frames(animator, slow)
+    every = np.concatenate([pos, fingers], axis=1)
+    jump = float(np.linalg.norm(np.diff(every, axis=0), axis=-1).max()) if len(slow) > 1 else 0.0
+    chest = rot[:, _SK.index("Chest")]
+    torso = 0.0
+    for i in range(0, len(chest), 3):
+        torso = max(torso, float(quat.angle_between(chest[i], chest).max()))
+    u = np.linspace(0.0, 1.0, 9)[:, None, None]
+    collide = np.zeros(len(slow), dtype=bool)
+    for a, b in SEGMENTS:
+        pa, pb = pos[:, _SK.index(a)], pos[:, _SK.index(b)]
+        pts = pa[None] + u * (pb - pa)[None]  # (9, k, 3)
+        hit = _in_board(pts, animator) | _in_body(pts, animator)
+        collide |= hit.any(axis=0)
+    nut, _, lateral, front, _ = _neck_frame(animator)
+    wrist = pos[:, _SK.index("LeftHand")] - nut
+    elbow = pos[:, _SK.index("LeftForeArm")] - nut
+    tip = pos[:, _SK.index("LeftHandEnd")] - nut
+    side = (
+        (wrist @ lateral > tip @ lateral)
+        & (wrist @ lateral > BOARD_HALF_WIDTH_M - 0.01)
+        & (wrist @ front - tip @ front < 0.02)
+        & (elbow @ front < 0.0)
+    )
+    positions = [position_of(p.motion) for p in sorted(bass, key=lambda p: p.time) if p.fret]
+    known = [x for x in positions if x is not None]
+    shifts = sum(1 for a, b in zip(known, known[1:], strict=False) if a != b)
+    return BassistFigures(
+        notes=len(bass),
+        contact_max_m=max(contacts, default=0.0),
+        contacts_over=sum(1 for c in contacts if c > 0.01),
+        timing_max_s=max((abs(c.timing_s) for c in checks), default=0.0),
+        wrist_p99=float(np.percentile(speed, 99)) if len(speed) else 0.0,
+        wrist_max=float(speed.max()) if len(speed) else 0.0,
+        jump_max_m=jump,
+        torso_range_deg=float(np.degrees(torso)),
+        collision_frames=int(collide.sum()),
+        frames=len(slow),
+        side_share=float(side.mean()) if len(side) else 1.0,
+        shifts=shifts,
+        stopped=len(positions),
+    )

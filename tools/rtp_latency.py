@@ -2,8 +2,8 @@
 
 A benchmark, not a test.  node-rtpmidi (tools/node/rtp_peer.js) invites an
 in-process RTP-MIDI listener (:class:`virja.rtpmidi.transport.Listener`, the
-one ``virja serve --rtp-midi`` runs, on the same asyncio loop as the drawing,
-as in serve), syncs, and sends ``--notes`` notes ``--gap-ms`` apart,
+one ``virja serve --rtp-midi`` runs, drawing on the same asyncio loop, as serve
+did before its window moved to a viewer process), syncs, and sends ``--notes`` notes ``--gap-ms`` apart,
 alternating a snare on channel 10 and a bass note on channel 1.  Each note
 goes the serve path: the session host, the router, the scheduler with the
 jam's immediate strokes, the animator, and the full band drawn headless at

@@ -39,7 +39,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
 fi
 
 # Node tools the tests run (tools/node/package.json, pinned by its package-lock.json):
-# the Khronos glTF Validator checks `virja export --gltf` output.
+# the Khronos glTF Validator checks `virja export --gltf` output; node-rtpmidi (npm
+# "rtpmidi") is the independent RTP-MIDI peer.  `npm install --omit=optional`, not
+# `npm ci`: rtpmidi names optional native mDNS modules (one a git dependency) that the
+# lock cannot hold, so `npm ci` refuses it as out of sync; install keeps the lock as is.
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
   SUDO=""
   [ "$(id -u)" -ne 0 ] && SUDO="sudo"
@@ -50,6 +53,6 @@ fi
 node_stamp=tools/node/node_modules/.virja-installed
 if [ ! -f "$node_stamp" ] || [ tools/node/package-lock.json -nt "$node_stamp" ]; then
   echo "setup: installing the node test tools into tools/node/node_modules"
-  (cd tools/node && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  (cd tools/node && npm install --omit=optional --no-audit --no-fund --loglevel=error >/dev/null)
   touch "$node_stamp"
 fi

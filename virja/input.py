@@ -38,6 +38,7 @@ class PerformanceInput:
     report: list[str] = field(default_factory=list)
     midi: MidiSession | None = None
     receiver_stats: dict[str, Any] = field(default_factory=dict)
+    immediate: bool = False  # live notes played at once (RTP-MIDI): strokes as short as a jam's
 
     def default_span(self) -> tuple[float, float]:
         """From the first reveal (early enough for the first motion) to the end plus a tail."""
@@ -137,6 +138,17 @@ def midi_input(path: Path, routing: RoutingConfig, lookahead_beats: float) -> Pe
     )
 
 
+def rtp_midi_report(rtp: Any) -> list[str]:
+    if rtp.control_port is None:
+        return []
+    st = rtp.stats
+    return [
+        f"RTP-MIDI on ports {rtp.control_port}/{rtp.control_port + 1}: "
+        f"{st.sessions_opened} sessions, {st.messages} MIDI messages, "
+        f"drops {dict(st.dropped) or 'none'}"
+    ]
+
+
 def pcap_input(
     path: Path, routing: RoutingConfig, *, port: int | None = None, key_file: str | None = None
 ) -> PerformanceInput:
@@ -144,8 +156,18 @@ def pcap_input(
     from virja.rmcp.pcap import read_capture
     from virja.rmcp.receiver import Receiver, ReceiverConfig
     from virja.rmcp.signing import load_key
+    from virja.rtpmidi.recording import replay as rtp_midi_replay
 
-    cap = read_capture(path, port=DEFAULT_PORT if port is None else port)
+    rmcp_port = DEFAULT_PORT if port is None else port
+    cap = read_capture(path, port=None, allow_empty=True)
+    rtp = rtp_midi_replay(cap.datagrams, skip_port=rmcp_port)
+    cap.datagrams = [d for d in cap.datagrams if d.dst[1] == rmcp_port]
+    if not cap.datagrams and rtp.control_port is None:
+        raise InputFileError(
+            path,
+            f"no UDP datagrams to port {rmcp_port} among {cap.packets} packets "
+            "and no RTP-MIDI session (wrong --port?)",
+        )
     key = load_key(key_file) if key_file else None
     receiver = Receiver(ReceiverConfig(key=key, answer_clock=False))
     schedule: list[Reveal] = []
@@ -153,6 +175,8 @@ def pcap_input(
         receiver.receive_datagram(dg.payload, dg.src, now_us=dg.time_us)
         for rec in receiver.drain_events():
             schedule.append(Reveal(rec.arrival_s, rec.event))
+    schedule += [Reveal(rec.arrival_s, rec.event) for rec in rtp.received]
+    schedule.sort(key=lambda r: r.at_s)  # stable: each source keeps its order
     dry = Router(routing)
     routed = _routed_notes((r.event for r in schedule), dry)
     notes = sum(1 for _note, who in routed if who is not None)
@@ -166,6 +190,7 @@ def pcap_input(
     report = [
         f"{path}: {cap.packets} packets, {len(cap.datagrams)} RMCP datagrams, "
         f"{stats['events']} events accepted, drops {stats['dropped'] or 'none'}",
+        *rtp_midi_report(rtp),
         *dry.report(),
         *routing_hints(routed, {}),
     ]
@@ -179,4 +204,5 @@ def pcap_input(
         note_count=notes,
         report=report,
         receiver_stats=stats,
+        immediate=rtp.control_port is not None,
     )

@@ -39,6 +39,7 @@ class BatchSettings:
 
 
 def _performance(src: PerformanceInput, settings: BatchSettings, *, animate: bool) -> Performance:
+    from virja.plan.immediate import immediate_strokes
     from virja.plan.planner import OnlinePlanner
 
     router = (
@@ -52,7 +53,12 @@ def _performance(src: PerformanceInput, settings: BatchSettings, *, animate: boo
 
         animator = BandAnimator()
     return Performance(
-        router=router, planner=OnlinePlanner(settings.plan, tempo=src.tempo), animator=animator
+        router=router,
+        # a recording's RTP-MIDI notes were played at once, as live (docs/rtp-midi.md)
+        planner=OnlinePlanner(
+            immediate_strokes(settings.plan) if src.immediate else settings.plan, tempo=src.tempo
+        ),
+        animator=animator,
     )
 
 

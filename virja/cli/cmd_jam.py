@@ -26,6 +26,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
+from virja.cli import rtp_midi
 from virja.cli.common import finite_float
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import section
@@ -102,6 +103,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--config", default=None, metavar="FILE.toml", help="configuration file")
     add_web_arguments(parser)
+    rtp_midi.add_argument(parser)
 
 
 def _options(args: argparse.Namespace, doc: dict[str, Any]) -> JamOptions:
@@ -144,31 +146,19 @@ def _plan_log(path: str | None) -> Iterator[IO[str] | None]:
         yield fh
 
 
-IMMEDIATE_STROKE_S = 0.012  # default jam mode: a key's stroke lands within a frame
-
-
 def jam_plan_config(config_path: str | None, delay_s: float) -> Any:
     """The scheduler's tables for a jam.
 
     Without --delay-ms a key's note is already due when it arrives, so every
     motion is compressed; its shortest stroke is cut to IMMEDIATE_STROKE_S so the
-    impact is drawn within a frame of the key.  With a delay at least as long as
-    the longest anticipation the tables are used as they are.
+    impact is drawn within a frame of the key (:mod:`virja.plan.immediate`).  With a
+    delay at least as long as the longest anticipation the tables are used as they are.
     """
-    import dataclasses
-
     from virja.plan.config import load_plan_config
+    from virja.plan.immediate import immediate_strokes
 
     config = load_plan_config(config_path)
-    if delay_s > 0:
-        return config
-    kinds = {
-        k: dataclasses.replace(
-            mt, min_anticipation_s=min(mt.min_anticipation_s, IMMEDIATE_STROKE_S)
-        )
-        for k, mt in config.timing.kinds.items()
-    }
-    return dataclasses.replace(config, timing=dataclasses.replace(config.timing, kinds=kinds))
+    return config if delay_s > 0 else immediate_strokes(config)
 
 
 def build_performance(
@@ -216,6 +206,7 @@ def run(args: argparse.Namespace) -> int:
     if args.list_ports:
         return _list_ports(opts.api)
     send_to = parse_hostport(opts.send) if opts.send else None
+    rtp_midi.check(args)
 
     api = probe_api(opts.api)
     clock = SessionClock()
@@ -253,6 +244,9 @@ def run(args: argparse.Namespace) -> int:
         jam = KeyboardJam(opts.layout, delay_s=opts.delay_s, thru=thru, stream=stream)
         midi_in = MidiInput(api, jam.handle, clock.now_s, port=opts.port)
         stack.callback(midi_in.close)
+        rtp = rtp_midi.start_jam(args, clock, jam.handle)  # network keys, as the keyboard's
+        if rtp is not None:
+            stack.callback(rtp.close)
 
         where = "connected to" if opts.port else "open, connect your keyboard to"
         print(f"virja jam: {api} input {where} {midi_in.name}")

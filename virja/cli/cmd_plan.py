@@ -70,12 +70,13 @@ def _plan_pcap(
     src: PerformanceInput, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
     """A recording through the live receiver and planner on its recorded clock."""
-    from virja.plan import OnlinePlanner, load_plan_config
+    from virja.cli.rtp_midi import plan_config
+    from virja.plan import OnlinePlanner
     from virja.routing import Router
     from virja.session import Performance, run_schedule
 
     routing = routing_config(args, doc)
-    planner = OnlinePlanner(load_plan_config(args.config))
+    planner = OnlinePlanner(plan_config(args.config, immediate=src.immediate))
     perf = Performance(router=Router(routing), planner=planner)
     return run_schedule(perf, src.schedule), planner.report
 

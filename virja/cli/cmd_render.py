@@ -175,9 +175,9 @@ def check_outputs(args: argparse.Namespace, out: object) -> None:
 
 def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], out: object) -> int:
     """Shared by `render` and `replay --out`: plan, animate, draw, encode."""
+    from virja.cli.rtp_midi import plan_config
     from virja.input import PerformanceInput
     from virja.motion.band import BandAnimator
-    from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
     from virja.render.offline import OutputSpec, render_offline
     from virja.render.video import make_audio_track, temp_workdir
@@ -185,7 +185,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
 
     assert isinstance(src, PerformanceInput) and isinstance(out, OutputSpec)
     plan_log = open_plan_log(args.plan_log)
-    planner = OnlinePlanner(load_plan_config(args.config), tempo=src.tempo)
+    planner = OnlinePlanner(plan_config(args.config, immediate=src.immediate), tempo=src.tempo)
     animator = BandAnimator()
     perf = Performance(
         router=make_router(args, src.midi), planner=planner, animator=animator, plan_log=plan_log

@@ -6,7 +6,9 @@ band is rendered headless to a video or PNG frames (as `virja render`); with
 --headless nothing is drawn (plan log and summary only, as fast as possible);
 otherwise it plays in a window in real time (and with --web to browsers,
 window or not).  Reads pcaps written by
-`virja serve --record`, tcpdump or Wireshark (pcap and pcapng).
+`virja serve --record`, tcpdump or Wireshark (pcap and pcapng).  RTP-MIDI
+sessions in the recording (`serve --rtp-midi`) are found by their invitation
+and replayed through the same session host, their notes played at once as live.
 
 examples:
   virja replay session.pcap --headless --plan-log replay.jsonl
@@ -102,8 +104,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def play(src: object, args: argparse.Namespace) -> int:
+    from virja.cli.rtp_midi import plan_config
     from virja.input import PerformanceInput
-    from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
     from virja.session import Performance, run_schedule
 
@@ -111,7 +113,7 @@ def play(src: object, args: argparse.Namespace) -> int:
     plan_log = open_plan_log(args.plan_log)
     perf = Performance(
         router=make_router(args),
-        planner=OnlinePlanner(load_plan_config(args.config)),
+        planner=OnlinePlanner(plan_config(args.config, immediate=src.immediate)),
         plan_log=plan_log,
     )
     try:

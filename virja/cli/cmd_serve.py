@@ -14,6 +14,7 @@ examples:
   virja serve --listen [::]:50500 --group 239.255.50.50
   virja serve --headless --web 127.0.0.1:8080   # watch at http://127.0.0.1:8080/
   virja send virja/demo/blues.mid --to 127.0.0.1:50500   # in another shell
+  virja serve --rtp-midi 0.0.0.0:5004 --bass-channel 1     # a Mac's network MIDI (docs/rtp-midi.md)
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from virja.cli import rtp_midi
 from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import load_config
@@ -112,6 +114,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no status line")
     add_web_arguments(p)
     add_routing_arguments(p)
+    rtp_midi.add_argument(p)
 
 
 @dataclass
@@ -260,7 +263,6 @@ async def serve(args: argparse.Namespace) -> int:
     from virja.live.sinks import Fanout
     from virja.live.timer import DeadlineTimer, wake_in
     from virja.live.viewer import Viewer, ViewerSpec
-    from virja.plan.config import load_plan_config
     from virja.plan.planner import OnlinePlanner
     from virja.render.offline import parse_size
     from virja.rmcp.pcap import PcapWriter
@@ -276,6 +278,7 @@ async def serve(args: argparse.Namespace) -> int:
     if args.horizon <= 0 or args.lateness_ms < 0:
         raise ConfigError("--horizon must be > 0 and --lateness-ms >= 0")
     host, port = parse_hostport(args.listen)
+    rtp_midi.check(args)  # a bad --rtp-midi fails before anything is bound
     key = load_key(args.key_file) if args.key_file else None
     clock = SessionClock()
     receiver = Receiver(
@@ -287,7 +290,7 @@ async def serve(args: argparse.Namespace) -> int:
     # bind first: a port in use must not cost the user an existing plan log or recording
     perf = Performance(
         router=make_router(args),
-        planner=OnlinePlanner(load_plan_config(args.config)),
+        planner=OnlinePlanner(rtp_midi.plan_config(args.config, immediate=bool(args.rtp_midi))),
     )
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
     if not 1 <= args.fps <= 1000:
@@ -296,10 +299,11 @@ async def serve(args: argparse.Namespace) -> int:
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
-    viewer = web = None
+    viewer = web = rtp = None
     sinks = Fanout()  # where committed motions go: the window's process, an animator for --web
     try:
         web = open_web(args, perf, lambda: clock.now_us() / 1e6)
+        rtp = await rtp_midi.start_serve(args, clock, daemon)
         if web is not None:  # the browsers' frames are posed here, by an animator of our own
             from virja.motion.band import BandAnimator
 
@@ -321,8 +325,12 @@ async def serve(args: argparse.Namespace) -> int:
             local_host = ("::1" if ":" in bound[0] else "127.0.0.1") if wildcard else bound[0]
             recorder = PcapWriter.open(args.record, local=(local_host, bound[1]))
             protocol.recorder = daemon.recorder = recorder
+            if rtp is not None:
+                rtp.recorder = recorder
     except BaseException:
         transport.close()
+        if rtp is not None:
+            await rtp.close()
         if viewer is not None:
             viewer.close()
         if web is not None:
@@ -392,6 +400,8 @@ async def serve(args: argparse.Namespace) -> int:
             with contextlib.suppress(asyncio.CancelledError, Exception):
                 await t
         transport.close()
+        if rtp is not None:
+            await rtp.close()
         if viewer is not None:
             loop.remove_reader(viewer.sentinel)
         # each step on its own: a failure is one warning, and the summary still comes
@@ -412,6 +422,7 @@ async def serve(args: argparse.Namespace) -> int:
             with survive_tick():
                 web.close()
     print("virja serve: stopped")
-    for line in daemon.summary() + ([web.summary()] if web is not None else []):
+    extra = ([web.summary()] if web is not None else []) + (rtp.summary() if rtp else [])
+    for line in daemon.summary() + extra:
         print(f"  {line}")
     return 0

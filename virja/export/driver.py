@@ -26,6 +26,7 @@ from virja.input import PerformanceInput, load_performance_input, nothing_for_th
 from virja.motion.band import BandAnimator
 from virja.motion.export import performance_to_bvh
 from virja.plan.config import PlanConfig, load_plan_config
+from virja.plan.immediate import immediate_strokes
 from virja.plan.planner import OnlinePlanner
 from virja.plan.types import PlannedNote
 from virja.routing import Router, RoutingConfig
@@ -191,6 +192,8 @@ def export_performance(
     # bassist's clips do not cover yet still gets its tablature)
     animator = BandAnimator() if (g or b) else None
     router = Router.for_session(src.midi, routing) if src.midi is not None else Router(routing)
+    if src.immediate:  # a recording's RTP-MIDI notes were played at once, as live
+        plan_config = immediate_strokes(plan_config)
     perf = Performance(
         router=router, planner=OnlinePlanner(plan_config, tempo=src.tempo), animator=animator
     )

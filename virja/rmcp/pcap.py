@@ -115,14 +115,21 @@ class PcapWriter:
             raise InputFileError(path, f"cannot write recording: {exc.strerror or exc}") from None
 
     def write(
-        self, payload: bytes, src: tuple[str, int] | tuple[str, int, int, int], *, time_us: int
+        self,
+        payload: bytes,
+        src: tuple[str, int] | tuple[str, int, int, int],
+        *,
+        time_us: int,
+        dst: tuple[str, int] | None = None,
     ) -> None:
-        """Append one received datagram from ``src`` stamped ``time_us``."""
+        """Append one received datagram from ``src`` stamped ``time_us``
+        (received on ``dst``, by default the writer's ``local`` address)."""
         if self.failed is not None:
             return
         self._ident = (self._ident + 1) & 0xFFFF
+        to = self._local if dst is None else dst
         try:
-            pkt = udp_packet(src[0], src[1], self._local[0], self._local[1], payload, self._ident)
+            pkt = udp_packet(src[0], src[1], to[0], to[1], payload, self._ident)
         except ValueError:  # a source that is not an IP address (never from UDP)
             log.warning("not recording a datagram from non-IP source %r", src)
             return
@@ -343,9 +350,9 @@ def _pcapng(path: str, data: bytes, cap: Capture) -> Iterator[Frame]:
 
 
 def read_capture(
-    path: str | Path, *, port: int = DEFAULT_PORT, allow_empty: bool = False
+    path: str | Path, *, port: int | None = DEFAULT_PORT, allow_empty: bool = False
 ) -> Capture:
-    """The UDP datagrams to ``port`` in a pcap or pcapng file, in file order.
+    """The UDP datagrams to ``port`` (None: to any port) in a pcap or pcapng file, in file order.
 
     Raises InputFileError for unreadable, unknown or corrupt files, and, unless
     ``allow_empty``, when no datagram was sent to ``port``.
@@ -376,7 +383,7 @@ def read_capture(
             cap.other_packets += 1
             continue
         udp = udp_from_frame(linktype, frame)
-        if udp is None or udp.dport != port:
+        if udp is None or (port is not None and udp.dport != port):
             cap.other_packets += 1
             continue
         cap.datagrams.append(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import mido
@@ -77,3 +78,21 @@ def test_motion_report_prints_the_bassists_figures(
     assert "fretting hand on the correct side: 100.0 %" in out
     assert "hand shifts:" in out
     assert "MISS" not in out.split("bassist:")[1]
+    err = capsys.readouterr().err
+    assert main(["motion-report", str(mid), "--fps", "30", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["bass"]["figures"]["side_share"] == 1.0 and doc["bass"]["meets_targets"]
+    del err
+
+
+def test_motion_report_says_it_is_working_and_gives_verdicts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mid = _walk(tmp_path, 200.0)
+    assert main(["motion-report", str(mid), "--fps", "30"]) == 0
+    out, err = capsys.readouterr()
+    assert "motion-report: measuring" in err and "motion-report: done in" in err
+    continuity = next(line for line in out.splitlines() if line.startswith("continuity"))
+    assert "[ok" in continuity or "[MISS" in continuity
+    drummer = out.split("drummer:")[1].split("bassist:")[0].splitlines()[1:]
+    assert drummer and all(line.rstrip().endswith(("ok", "MISS")) for line in drummer)

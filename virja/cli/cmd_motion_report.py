@@ -21,7 +21,9 @@ Example:  virja motion-report song.mid
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import sys
 import time
 from collections import Counter
 from pathlib import Path
@@ -95,13 +97,16 @@ def run(args: argparse.Namespace) -> int:
             f"{path}: no bass or drum notes in the first {args.max_seconds:g} s; nothing to measure"
         )
         return 0
+    progress = Stage(len(planned), args.max_seconds)
     animator = BandAnimator()
     animator.use_bass_strings(tuple(name for name, _ in config.bass.strings))
     for beat in session.beats:
         animator.add_beat(beat)
     for p in planned:
         animator.add_planned(p)
+    progress("impact timing, contact and continuity")
     rep = measure(animator, planned, fps=args.fps)
+    progress("the drummer's speeds, jumps, torso, collisions and hi-hat")
     kit = config.kit
     drummer = measure_drummer(
         animator, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=args.fps
@@ -114,8 +119,17 @@ def run(args: argparse.Namespace) -> int:
         animator.pose(start + i / 60.0)
     pose_ms = (time.perf_counter() - t0) * 1e3 / n
 
+    progress("the bassist's hands, body and fingering")
+    bassist = measure_bassist(animator, planned, rep)
+    progress.done()
     if args.json:
-        print(json.dumps(_json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)))
+        doc = _json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)
+        if bassist is not None:
+            doc["bass"] |= {
+                "figures": dataclasses.asdict(bassist),
+                "meets_targets": bassist.meets_targets,
+            }
+        print(json.dumps(doc))
         return 0
     if args.per_note:
         print(f"{'impact s':>9} {'motion':<22} {'contact mm':>10} {'fret mm':>8} {'timing ms':>9}")
@@ -138,15 +152,51 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"continuity (largest angular-velocity jump per frame at {args.fps:g} fps): "
         f"connections {rep.continuity_connection:.1f} rad/s, within clips {rep.continuity_within:.1f} rad/s"
+        f"  [{_continuity_verdict(rep)}]"
     )
     print(f"pose time (both players): {pose_ms:.2f} ms per frame")
     for line in _drummer_table(rep, drummer, drops):
         print(line)
-    bassist = measure_bassist(animator, planned, rep)
     if bassist is not None:
         for line in bassist.lines():
             print(line)
     return 0
+
+
+CONTINUITY_RATIO = 1.5  # a connection may change velocity this much more than a clip does
+
+
+def _continuity_verdict(rep: MotionReport) -> str:
+    """ok when crossing from one motion to the next is about as smooth as moving within one."""
+    if rep.continuity_within <= 0:
+        return "ok"
+    ratio = rep.continuity_connection / rep.continuity_within
+    if ratio <= CONTINUITY_RATIO:
+        return f"ok: connections {ratio:.2f}x the clips', target <= {CONTINUITY_RATIO:g}x"
+    return f"MISS: connections {ratio:.2f}x the clips', target <= {CONTINUITY_RATIO:g}x"
+
+
+class Stage:
+    """One line on stderr per stage, with the time the last one took: the report takes
+    tens of seconds on a long file, and a user should see it working."""
+
+    def __init__(self, notes: int, seconds: float) -> None:
+        self.started = time.perf_counter()
+        print(
+            f"motion-report: {notes} notes planned (first {seconds:g} s); measuring...",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    def __call__(self, what: str) -> None:
+        print(f"motion-report: measuring {what}...", file=sys.stderr, flush=True)
+
+    def done(self) -> None:
+        print(
+            f"motion-report: done in {time.perf_counter() - self.started:.1f} s",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def _split(rep: MotionReport) -> dict[str, list[NoteCheck]]:
@@ -199,31 +249,64 @@ def _drummer_table(rep: MotionReport, drummer: DrummerFigures, drops: Counter[st
     d = _figure(_split(rep)["drums"])
     agree = drummer.hihat_agreement
     hits = {k: v for k, v in drummer.collisions.items() if v}
+    real_drops = {k: v for k, v in drops.items() if k != "too_many_hands"}
     rows = [
-        ("contact at impact (max)", f"{d['contact_max_mm']:.2f} mm", "< 10 mm"),
-        ("timing error (max)", f"{d['timing_max_ms']:.1f} ms", "0 ms"),
-        ("wrist speed p99", f"{drummer.wrist_speed_p99:.2f} m/s", "<= 5 m/s"),
-        ("wrist speed max", f"{drummer.wrist_speed_max:.2f} m/s", "<= 8 m/s"),
-        ("largest hand jump at 30 fps", f"{drummer.hand_jump_30fps_m * 100:.1f} cm", "<= 15 cm"),
-        ("torso turn range", f"{drummer.torso_range_deg:.1f} deg", ">= 3 deg"),
+        (
+            "contact at impact (max)",
+            f"{d['contact_max_mm']:.2f} mm",
+            "< 10 mm",
+            d["contact_max_mm"] < 10,
+        ),
+        ("timing error (max)", f"{d['timing_max_ms']:.1f} ms", "0 ms", d["timing_max_ms"] <= 0.5),
+        (
+            "wrist speed p99",
+            f"{drummer.wrist_speed_p99:.2f} m/s",
+            "<= 5 m/s",
+            drummer.wrist_speed_p99 <= 5,
+        ),
+        (
+            "wrist speed max",
+            f"{drummer.wrist_speed_max:.2f} m/s",
+            "<= 8 m/s",
+            drummer.wrist_speed_max <= 8,
+        ),
+        (
+            "largest hand jump at 30 fps",
+            f"{drummer.hand_jump_30fps_m * 100:.1f} cm",
+            "<= 15 cm",
+            drummer.hand_jump_30fps_m <= 0.15,
+        ),
+        (
+            "torso turn range",
+            f"{drummer.torso_range_deg:.1f} deg",
+            ">= 3 deg",
+            drummer.torso_range_deg >= 3,
+        ),
         (
             "collisions",
             ", ".join(f"{k} {v}" for k, v in sorted(hits.items())) or "0",
             "0",
+            not hits,
         ),
         (
             "hi-hat agreement",
             "-" if agree is None else f"{agree * 100:.1f} % of {drummer.hihat_notes}",
             "100 %",
+            agree is None or agree >= 1.0,
         ),
         (
             "dropped",
             ", ".join(f"{k} {v}" for k, v in sorted(drops.items())) or "0",
             "0 (but too_many_hands)",
+            not real_drops,
         ),
     ]
     w0 = max(len(r[0]) for r in rows)
     w1 = max(len(r[1]) for r in rows)
+    w2 = max(len(r[2]) for r in rows)
     out = ["drummer:"]
-    out += [f"  {a:<{w0}}  {b:<{w1}}  target {c}" for a, b, c in rows]
+    out += [
+        f"  {a:<{w0}}  {b:<{w1}}  target {c:<{w2}}  {'ok' if good else 'MISS'}"
+        for a, b, c, good in rows
+    ]
     return out

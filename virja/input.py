@@ -39,6 +39,9 @@ class PerformanceInput:
     midi: MidiSession | None = None
     receiver_stats: dict[str, Any] = field(default_factory=dict)
     immediate: bool = False  # live notes played at once (RTP-MIDI): strokes as short as a jam's
+    # the session time a user calls 0 (options like --at, printed times): a MIDI file's
+    # start, a recording's first packet (its times are Unix time inside)
+    start_s: float = 0.0
 
     def default_span(self) -> tuple[float, float]:
         """From the first reveal (early enough for the first motion) to the end plus a tail."""
@@ -160,6 +163,7 @@ def pcap_input(
 
     rmcp_port = DEFAULT_PORT if port is None else port
     cap = read_capture(path, port=None, allow_empty=True)
+    start_s = min((d.time_us for d in cap.datagrams), default=0) / 1e6
     rtp = rtp_midi_replay(cap.datagrams, skip_port=rmcp_port)
     cap.datagrams = [d for d in cap.datagrams if d.dst[1] == rmcp_port]
     if not cap.datagrams and rtp.control_port is None:
@@ -205,4 +209,5 @@ def pcap_input(
         report=report,
         receiver_stats=stats,
         immediate=rtp.control_port is not None,
+        start_s=start_s,
     )

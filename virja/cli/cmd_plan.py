@@ -98,9 +98,17 @@ def _fmt(value: object) -> str:
     return str(value)
 
 
-def _table(planned: list[PlannedNote]) -> list[str]:
+def _table(planned: list[PlannedNote], origin_s: float = 0.0) -> list[str]:
+    """The plan as a table, times in seconds from ``origin_s`` (a recording's start)."""
     cols = ["time", "performer", "note", "limb", "motion", "start", "impact", "cost", "late"]
-    rows = [[_fmt(getattr(p, c)) if c != "late" else ("LATE" if p.late else "") for c in cols]
+
+    def cell(p: PlannedNote, c: str) -> str:
+        if c == "late":
+            return "LATE" if p.late else ""
+        value = getattr(p, c)
+        return _fmt(value - origin_s if c in ("time", "start", "impact") else value)
+
+    rows = [[cell(p, c) for c in cols]
             for p in sorted(planned, key=lambda p: (p.time, p.performer, p.start))]  # fmt: skip
     widths = [max([len(c)] + [len(r[i]) for r in rows]) for i, c in enumerate(cols)]
     lines = ["  ".join(c.ljust(w) for c, w in zip(cols, widths, strict=True)).rstrip()]
@@ -108,7 +116,7 @@ def _table(planned: list[PlannedNote]) -> list[str]:
     return lines
 
 
-def _summary(planned: list[PlannedNote], report: PlanReport) -> list[str]:
+def _summary(planned: list[PlannedNote], report: PlanReport, origin_s: float = 0.0) -> list[str]:
     per = Counter(p.performer for p in planned)
     cost: dict[str, float] = {"bass": 0.0, "drums": 0.0}
     for p in planned:
@@ -130,7 +138,7 @@ def _summary(planned: list[PlannedNote], report: PlanReport) -> list[str]:
         )
     lines.append(
         f"moved by octaves: {len(report.moved)}"
-        + "".join(f"; {m.note.note} -> {m.played_note} at {m.note.time_s:.3f} s"
+        + "".join(f"; {m.note.note} -> {m.played_note} at {m.note.time_s - origin_s:.3f} s"
                   for m in report.moved[:10])
         + (" ..." if len(report.moved) > 10 else "")
     )  # fmt: skip
@@ -161,9 +169,14 @@ def run(args: argparse.Namespace) -> int:
         except BrokenPipeError:  # `virja plan --json ... | head`
             return 0
         return 0
-    for line in _table(planned):
+    if src.start_s:
+        print(
+            f"times: seconds from the recording's start (session time {src.start_s:.6f} s; "
+            "--json gives session time)"
+        )
+    for line in _table(planned, src.start_s):
         print(line)
     print()
-    for line in _summary(planned, report):
+    for line in _summary(planned, report, src.start_s):
         print(line)
     return 0

@@ -192,22 +192,28 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
     )
     feeder = RevealFeeder(src.schedule)
     t0, t1 = src.default_span()
+    base = (
+        src.start_s
+    )  # --at, --start, --end: seconds from the input's start (for MIDI files and recordings alike)
     if args.start is not None:
-        t0 = args.start
+        t0 = base + args.start
     if args.end is not None:
-        t1 = args.end
+        t1 = base + args.end
     if args.at is not None:
-        t0 = t1 = args.at
+        t0 = t1 = base + args.at
         # everything known before the frame must have been fed: start the feeder there
     if t1 < t0:
-        raise ConfigError(f"nothing to render: end {t1:.3f} s is before start {t0:.3f} s")
+        raise ConfigError(
+            f"nothing to render: end {t1 - base:.3f} s is before start {t0 - base:.3f} s"
+        )
     first_s, last_s = src.default_span()
-    if args.at is not None and not first_s <= args.at <= last_s:
+    if args.at is not None and not first_s <= base + args.at <= last_s:
         log.warning(
-            "--at %.3f s is outside the performance (%.3f to %.3f s): the band is idle there",
+            "--at %.3f s is outside the performance (%.3f to %.3f s from the start of the "
+            "input): the band is idle there",
             args.at,
-            first_s,
-            last_s,
+            first_s - base,
+            last_s - base,
         )
     if (t1 - t0) * args.fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
         raise ConfigError(
@@ -264,7 +270,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         where = f"{result.outputs[0]} ... {result.outputs[-1].name}"
     print(
         f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} "
-        f"({t1 - t0:.2f} s at {args.fps:g} fps from session time {t0:.2f} s) to {where} "
+        f"({t1 - t0:.2f} s at {args.fps:g} fps from {t0 - src.start_s:.2f} s) to {where} "
         f"in {result.seconds:.1f} s ({rate:.1f} frames/s); "
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )

@@ -234,3 +234,15 @@ def test_render_with_the_follow_camera(capsys: pytest.CaptureFixture[str], tmp_p
         "follow",
     )
     assert code == 0 and "follow camera:" in out and (tmp_path / "x.png").is_file()
+
+
+@pytest.mark.parametrize("frets", ["1", "3"])
+def test_too_few_frets_is_a_config_error_naming_the_minimum(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, frets: str
+) -> None:
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f"[plan]\nbass_frets = {frets}\n")
+    for cmd in (["plan", DEMO], ["render", DEMO, "--out", str(tmp_path / "x.png"), "--at", "1"]):
+        code, _, err = run(capsys, *cmd, "--config", str(cfg))
+        assert code == 1
+        one_line_error(err, f"bass frets = {frets}", "at least 4")

@@ -176,6 +176,14 @@ class BassSetup:
             raise ConfigError("bass strings must be listed low to high")
         if not 1 <= self.frets <= 36:
             raise ConfigError(f"bass frets must be 1-36, got {self.frets}")
+        # every note from the lowest open string up must be playable somewhere: the
+        # frets must reach from one open string to a semitone below the next
+        need = max((b - a - 1 for a, b in zip(opens, opens[1:], strict=False)), default=1)
+        if self.frets < need:
+            raise ConfigError(
+                f"bass frets = {self.frets} leaves notes between the open strings unplayable; "
+                f"this tuning needs at least {need} (36 at most)"
+            )
         if self.double_stop_span_frets < 0:
             raise ConfigError("double_stop_span_frets must be >= 0")
 

@@ -44,3 +44,19 @@ def test_late_note_is_compressed_and_marked(config: PlanConfig) -> None:
     b = align(config.timing, "snare", 1.0, 1.0 - mt.min_anticipation_s - 0.01, 0.5)
     assert b.start > 1.0 - mt.anticipation_s
     assert b.impact == 1.0 and not b.late
+
+
+def test_a_note_played_at_once_is_not_late_but_one_that_arrived_after_it_is() -> None:
+    """A jam key (or RTP-MIDI note) strikes the shortest stroke after it arrives: that is
+    how it is played, not lateness; arriving after its own time still is late."""
+    from virja.plan.config import default_config
+    from virja.plan.immediate import IMMEDIATE_STROKE_S, immediate_strokes
+    from virja.plan.timing import align
+
+    timing = immediate_strokes(default_config()).timing
+    at_once = align(timing, "snare", 10.0, known_s=10.0, seconds_per_beat=0.5)
+    assert at_once.impact == 10.0 + IMMEDIATE_STROKE_S and not at_once.late
+    after = align(timing, "snare", 10.0, known_s=10.05, seconds_per_beat=0.5)
+    assert after.late
+    file_note = align(default_config().timing, "snare", 10.0, known_s=10.0, seconds_per_beat=0.5)
+    assert file_note.late  # a file's note known at its time is late, as before

@@ -249,6 +249,9 @@ class Timing:
     rest_s: float
     kinds: dict[str, MotionTiming]
     moves: dict[tuple[str, str], float] = field(default_factory=dict)
+    # notes played at once (jam keys, RTP-MIDI: plan.immediate): the shortest stroke is
+    # their normal form, so a note is late only when it lands later than that
+    immediate: bool = False
 
     def get(self, kind: str) -> MotionTiming:
         try:

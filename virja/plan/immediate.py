@@ -3,7 +3,9 @@
 A note that arrives at its own time is compressed by the planner (it starts
 on arrival and strikes ``min_anticipation_s`` later).  For live input that
 floor is cut to :data:`IMMEDIATE_STROKE_S`, so the impact is drawn within a
-frame of the key.
+frame of the key, and such a note is not marked late: the short stroke is how
+a note played at once is played (``Timing.immediate``); only one that lands
+later still (a key that arrived after its time) is late.
 """
 
 from __future__ import annotations
@@ -23,4 +25,5 @@ def immediate_strokes(config: PlanConfig) -> PlanConfig:
         )
         for k, mt in config.timing.kinds.items()
     }
-    return dataclasses.replace(config, timing=dataclasses.replace(config.timing, kinds=kinds))
+    timing = dataclasses.replace(config.timing, kinds=kinds, immediate=True)
+    return dataclasses.replace(config, timing=timing)

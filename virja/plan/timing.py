@@ -44,5 +44,7 @@ def align(
     start = time_s - a
     if known_s <= start:
         return Alignment(start, time_s, False)
-    impact = max(time_s, known_s + timing.get(kind).min_anticipation_s)
-    return Alignment(known_s, impact, impact > time_s + LATE_EPS_S)
+    shortest = timing.get(kind).min_anticipation_s
+    impact = max(time_s, known_s + shortest)
+    allowed = shortest if timing.immediate else 0.0  # played at once: the stroke is the norm
+    return Alignment(known_s, impact, impact > time_s + allowed + LATE_EPS_S)

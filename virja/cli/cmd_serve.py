@@ -25,15 +25,19 @@ import contextlib
 import signal
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from virja.cli import rtp_midi
 from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import load_config
-from virja.errors import ConfigError
+from virja.errors import ConfigError, NotAvailableError
 from virja.faults import survive_tick
+
+if TYPE_CHECKING:
+    from virja.live.audio import LiveSynth
 
 STATUS_EVERY_S = 5.0
 RECORDER_FLUSH_S = 0.1  # the recording is flushed this often while it is open
@@ -58,6 +62,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="join this multicast group (e.g. 239.255.50.50); receivers may share it",
     )
     p.add_argument("--headless", action="store_true", help="no window; everything else the same")
+    p.add_argument(
+        "--audio",
+        action="store_true",
+        help="play the session's notes through fluidsynth at their time (the sound card's "
+        "default output; --audio-driver to choose)",
+    )
+    p.add_argument(
+        "--audio-driver",
+        metavar="NAME",
+        help="fluidsynth's audio driver: alsa, pulseaudio, jack, ... (default: fluidsynth's)",
+    )
+    p.add_argument("--soundfont", metavar="FILE.sf2", help="General MIDI soundfont for --audio")
     p.add_argument(
         "--hud",
         action="store_true",
@@ -258,6 +274,20 @@ def _report_clock_failure(task: asyncio.Task[Any]) -> None:
         print(f"virja serve: the clock client stopped: {exc}", file=sys.stderr, flush=True)
 
 
+def open_audio(args: argparse.Namespace, now_s: Callable[[], float]) -> LiveSynth:
+    """--audio: fluidsynth with the soundfont render would use (checked now, one line)."""
+    from virja.live.audio import LiveSynth
+    from virja.render.video import find_soundfont
+
+    sf = find_soundfont(args.soundfont)
+    if sf is None:
+        raise NotAvailableError(
+            "--audio needs a General MIDI soundfont: apt-get install fluid-soundfont-gm, "
+            "--soundfont FILE.sf2 or VIRJA_SOUNDFONT"
+        )
+    return LiveSynth(sf, now_s, driver=args.audio_driver)
+
+
 async def serve(args: argparse.Namespace) -> int:
     from virja.clock import SessionClock
     from virja.live.sinks import Fanout
@@ -299,10 +329,13 @@ async def serve(args: argparse.Namespace) -> int:
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
-    viewer = web = rtp = None
+    viewer = web = rtp = synth = None
     sinks = Fanout()  # where committed motions go: the window's process, an animator for --web
     try:
         web = open_web(args, perf, lambda: clock.now_us() / 1e6)
+        if args.audio:
+            synth = open_audio(args, clock.now_s)
+            perf.taps.append(synth)
         rtp = await rtp_midi.start_serve(args, clock, daemon)
         if web is not None:  # the browsers' frames are posed here, by an animator of our own
             from virja.motion.band import BandAnimator
@@ -329,6 +362,8 @@ async def serve(args: argparse.Namespace) -> int:
                 rtp.recorder = recorder
     except BaseException:
         transport.close()
+        if synth is not None:
+            synth.close()
         if rtp is not None:
             await rtp.close()
         if viewer is not None:
@@ -402,6 +437,9 @@ async def serve(args: argparse.Namespace) -> int:
         transport.close()
         if rtp is not None:
             await rtp.close()
+        if synth is not None:
+            with survive_tick():
+                synth.close()
         if viewer is not None:
             loop.remove_reader(viewer.sentinel)
         # each step on its own: a failure is one warning, and the summary still comes

@@ -40,6 +40,17 @@ Route = Performer | None
 _TARGETS: dict[str, Route] = {"bass": "bass", "drums": "drums", "none": None}
 
 
+# the keys of the [routing] table (docs/virja.example.toml documents each)
+ROUTING_KEYS = (
+    "drum_channels",
+    "bass_programs",
+    "bass_track_words",
+    "channels",
+    "tracks",
+    "names_over_programs",
+)
+
+
 @dataclass(frozen=True)
 class RoutingConfig:
     drum_channels: frozenset[int] = frozenset({10})  # 1-based
@@ -52,15 +63,7 @@ class RoutingConfig:
     @classmethod
     def from_dict(cls, table: Mapping[str, Any], where: str = "[routing]") -> RoutingConfig:
         """From the ``[routing]`` table of the config file; ``where`` names it in errors."""
-        known = {
-            "drum_channels",
-            "bass_programs",
-            "bass_track_words",
-            "channels",
-            "tracks",
-            "names_over_programs",
-        }
-        unknown = set(table) - known
+        unknown = set(table) - set(ROUTING_KEYS)
         if unknown:
             raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
         base = cls()

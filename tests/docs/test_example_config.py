@@ -10,10 +10,9 @@ from virja.errors import ConfigError
 from virja.jam.options import _KEYS as JAM_KEYS
 from virja.jam.options import JamOptions
 from virja.plan.config import load_plan_config, plan_config_from_table
-from virja.routing import RoutingConfig
+from virja.routing import ROUTING_KEYS, RoutingConfig
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "virja.example.toml"
-ROUTING_KEYS = ("drum_channels", "bass_programs", "bass_track_words", "channels", "tracks")
 
 
 def plan_keys() -> list[str]:

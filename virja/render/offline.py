@@ -18,6 +18,7 @@ from pathlib import Path
 
 from virja.errors import ConfigError
 from virja.render.camera import Camera
+from virja.render.glflush import flush
 from virja.render.hosts import OffscreenTarget, create_headless_context
 from virja.render.hud import HudOverlay
 from virja.render.images import write_png
@@ -122,16 +123,29 @@ def render_frames(
         raise ConfigError(f"--out {out.path}: the folder {folder} is not writable")
     if out.kind == "video":
         writer = VideoWriter(
-            out.path, size, fps, audio=audio, audio_offset_s=audio_offset_s, bottom_up=True
+            out.path,
+            size,
+            fps,
+            audio=audio,
+            audio_offset_s=audio_offset_s,
+            bottom_up=True,
+            queue_frames=3,
         )
         outputs.append(out.path)
     started = time.perf_counter()
     try:
+        # Pipelined: frame i is drawn and flushed (llvmpipe's threads rasterise
+        # it), then frame i+1's scene is built on this thread while they work,
+        # and only then is frame i read back; the writer thread feeds ffmpeg.
+        layers = scene_at(times[0]) if times else []
         for i, t in enumerate(times):
             cam = camera if isinstance(camera, Camera) else camera(t)
-            renderer.draw(scene_at(t), cam, target.fbo)
+            renderer.draw(layers, cam, target.fbo)
             if overlay is not None and hud is not None:
                 overlay.draw(target.fbo, hud(t))
+            flush()  # the rasteriser starts; we build the next scene meanwhile
+            if i + 1 < len(times):
+                layers = scene_at(times[i + 1])
             if writer is not None:
                 writer.write_raw(target.read_raw_rgb())  # GL row order; ffmpeg flips
             else:

@@ -82,14 +82,18 @@ class Renderer:
         self.ctx = ctx
         self.program = load_program(ctx, "solid")
         self._vbos: dict[str, moderngl.Buffer] = {}
+        self._ebos: dict[str, moderngl.Buffer] = {}
         self._ibos: dict[str, moderngl.Buffer] = {}
         self._vaos: dict[str, moderngl.VertexArray] = {}
         self._capacity: dict[str, int] = {}
         self._layer: moderngl.Framebuffer | None = None
         self._layer_key: tuple[object, ...] | None = None
         for kind, make in MESHES.items():
-            mesh = make()
-            self._vbos[kind] = ctx.buffer(mesh.tobytes())
+            # Indexed: each distinct vertex is shaded once per instance (llvmpipe's
+            # vertex cache), not once per triangle corner; the triangles are the same.
+            verts, index = np.unique(make(), axis=0, return_inverse=True)
+            self._vbos[kind] = ctx.buffer(np.ascontiguousarray(verts, dtype=np.float32).tobytes())
+            self._ebos[kind] = ctx.buffer(index.reshape(-1).astype(np.uint32).tobytes())
             self._alloc(kind, initial_instances)
 
     def _alloc(self, kind: str, capacity: int) -> None:
@@ -104,6 +108,8 @@ class Renderer:
                 (self._vbos[kind], "3f 3f", "in_position", "in_normal"),
                 (self._ibos[kind], "16f 4f/i", "in_model", "in_color"),
             ],
+            index_buffer=self._ebos[kind],
+            index_element_size=4,
         )
 
     def draw(
@@ -202,7 +208,7 @@ class Renderer:
 
     def release(self) -> None:
         self._release_layer()
-        for d in (self._vaos, self._ibos, self._vbos):
+        for d in (self._vaos, self._ibos, self._vbos, self._ebos):
             for obj in d.values():
                 obj.release()
         self.program.release()

@@ -14,6 +14,8 @@ import os
 import shutil
 import subprocess
 import tempfile
+import threading
+from queue import Queue
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -139,7 +141,13 @@ def render_audio(
 
 
 class VideoWriter:
-    """Pipes RGB frames to ffmpeg; adds an audio track at ``audio_offset_s`` if given."""
+    """Pipes RGB frames to ffmpeg; adds an audio track at ``audio_offset_s`` if given.
+
+    With ``queue_frames`` > 0 the pipe is fed from a writer thread holding up to
+    that many frames, so the caller (the GL loop) never waits on ffmpeg while it
+    has room: drawing, read-back and encoding overlap.  Frames keep their order;
+    a failed write is raised from the next :meth:`write_raw` or from :meth:`close`.
+    """
 
     def __init__(
         self,
@@ -151,6 +159,7 @@ class VideoWriter:
         crf: int = 20,
         preset: str = "superfast",
         bottom_up: bool = False,
+        queue_frames: int = 0,
     ) -> None:
         w, h = size
         if w % 2 or h % 2:
@@ -181,6 +190,34 @@ class VideoWriter:
         self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
         self._err_text: str | None = None
         self.frames = 0
+        self._queue: Queue[bytes | None] | None = None
+        self._thread: threading.Thread | None = None
+        self._failed: BaseException | None = None
+        if queue_frames > 0:
+            self._queue = Queue(maxsize=queue_frames)
+            self._thread = threading.Thread(target=self._feed, name="virja-ffmpeg", daemon=True)
+            self._thread.start()
+
+    def _feed(self) -> None:
+        """The writer thread: frames from the queue into ffmpeg's pipe, until None."""
+        assert self._queue is not None and self._proc.stdin is not None
+        while (data := self._queue.get()) is not None:
+            if self._failed is not None:
+                continue  # drain, so the producer never blocks on a dead pipe
+            try:
+                self._proc.stdin.write(data)
+            except (BrokenPipeError, OSError) as exc:
+                self._failed = exc
+
+    def _raise_failed(self) -> None:
+        if self._failed is not None:
+            raise NotAvailableError(f"ffmpeg stopped: {self._stderr()}") from self._failed
+
+    def _stop_thread(self) -> None:
+        if self._thread is not None and self._queue is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._thread = None
 
     def write_raw(self, data: bytes) -> None:
         """One frame of packed RGB bytes, in the row order the writer was opened with."""
@@ -189,6 +226,11 @@ class VideoWriter:
             raise ValueError(
                 f"frame of {len(data)} bytes, expected {self.size[0] * self.size[1] * 3}"
             )
+        if self._queue is not None:
+            self._raise_failed()
+            self._queue.put(data)
+            self.frames += 1
+            return
         try:
             self._proc.stdin.write(data)
         except BrokenPipeError as exc:
@@ -201,11 +243,7 @@ class VideoWriter:
             raise ValueError(
                 f"frame of shape {rgb.shape}, expected {(self.size[1], self.size[0], 3)}"
             )
-        try:
-            self._proc.stdin.write(np.ascontiguousarray(rgb).tobytes())
-        except BrokenPipeError as exc:
-            raise NotAvailableError(f"ffmpeg stopped: {self._stderr()}") from exc
-        self.frames += 1
+        self.write_raw(np.ascontiguousarray(rgb).tobytes())
 
     def _stderr(self) -> str:
         """What ffmpeg said (read once, kept: a failed write and the close both report it)."""
@@ -220,6 +258,7 @@ class VideoWriter:
         """Stop ffmpeg and remove the unfinished file (an interrupted render)."""
         self._proc.kill()
         self._proc.wait()
+        self._stop_thread()  # its writes fail on the dead pipe; it drains and ends
         for stream in (self._proc.stdin, self._proc.stderr):
             if stream is not None:
                 with contextlib.suppress(OSError):
@@ -228,6 +267,7 @@ class VideoWriter:
 
     def close(self) -> None:
         assert self._proc.stdin is not None
+        self._stop_thread()  # every queued frame written first
         # ffmpeg may already have stopped; its exit status and message say why
         with contextlib.suppress(BrokenPipeError):
             self._proc.stdin.close()

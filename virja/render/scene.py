@@ -11,6 +11,8 @@ lands on the drawn head.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -19,6 +21,7 @@ from numpy.typing import NDArray
 from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
+    _cross,
     box_transforms,
     disc_transforms,
     segment_transforms,
@@ -201,21 +204,36 @@ def _orient(b: Any) -> F64:
 
 
 def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
-    """Everything that moves, from a :class:`~virja.motion.pose.BandPose`."""
-    dl = DrawList()
-    _kit_dynamic(dl, geo, pose)
-    _strings(dl, geo, pose)
-    _figure(dl, pose.drums, DRUMMER_SHIRT)
+    """Everything that moves, from a :class:`~virja.motion.pose.BandPose`.
+
+    Vectorised: what depends only on the geometry (drum-head discs, colour and
+    index arrays of each figure) is built once per geometry and skeleton
+    (:func:`_kit_table`, :func:`_figure_table`); a frame gathers the segments
+    (strings, limbs, sticks) and spheres of every part and turns them into
+    instance matrices in one numpy pass each: no loop over hits, strings or
+    joints.  Rows keep the order of the plain per-part version
+    (tests/render/test_scene_vectorised.py).
+    """
+    kit_cyl, kit_color, bells = _kit_rows(geo, pose)
+    s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
+    stick = _Parts(
+        segments=[(s[:, 0], s[:, 1], np.full(len(s), 0.0075), _rows(STICK, len(s)))],
+        spheres=[(s[:, 1], np.full(len(s), 0.009), _rows(STICK, len(s)))],
+    )
     fingers = np.asarray(pose.bass_fingers, dtype=np.float64).reshape(-1, 2, 3)
+    parts = [bells, _string_parts(geo, pose), _figure_parts(pose.drums, DRUMMER_SHIRT)]
     if len(fingers):
         # fingers instead of the one-piece hands: a palm to the knuckles, two bones a finger
-        _figure(dl, pose.bass, BASSIST_SHIRT, skip=("LeftHandEnd", "RightHandEnd"))
-        _fingers(dl, pose.bass, fingers)
+        parts.append(_figure_parts(pose.bass, BASSIST_SHIRT, skip=("LeftHandEnd", "RightHandEnd")))
+        parts.append(_finger_parts(pose.bass, fingers))
     else:
-        _figure(dl, pose.bass, BASSIST_SHIRT)
-    s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
-    dl.add("cylinder", segment_transforms(s[:, 0], s[:, 1], 0.0075), STICK)
-    dl.add("sphere", sphere_transforms(s[:, 1], 0.009), STICK)
+        parts.append(_figure_parts(pose.bass, BASSIST_SHIRT))
+    parts.append(stick)
+    dl = DrawList()
+    seg, seg_color = _segment_rows(parts)
+    dl.add("cylinder", np.concatenate([kit_cyl, seg]), np.concatenate([kit_color, seg_color]))
+    sph, sph_color = _sphere_rows(parts)
+    dl.add("sphere", sph, sph_color)
     return dl
 
 
@@ -226,118 +244,381 @@ def figure_scene(fig: FigurePose, shirt: tuple[float, ...] = DANCER_SHIRT) -> Dr
     return dl
 
 
-def _kit_dynamic(dl: DrawList, geo: Geometry, pose: BandPose) -> None:
-    kit = geo.kit
-    for name, piece in kit.pieces.items():
+Segments = tuple[F64, F64, F64, F64]  # from (n, 3), to (n, 3), radius (n,), colour (n, 4)
+Spheres = tuple[F64, F64, F64]  # centre (n, 3), radius (n,), colour (n, 4)
+
+
+@dataclass
+class _Parts:
+    """Cylinders (as segments) and spheres of some moving parts, not yet matrices."""
+
+    segments: list[Segments]
+    spheres: list[Spheres]
+
+
+def _rows(color: tuple[float, ...], n: int) -> F64:
+    return np.broadcast_to(np.asarray(color, dtype=np.float64), (n, 4))
+
+
+def _segment_rows(parts: list[_Parts]) -> tuple[F64, F64]:
+    segs = [x for p in parts for x in p.segments]
+    a = np.concatenate([x[0] for x in segs])
+    b = np.concatenate([x[1] for x in segs])
+    r = np.concatenate([x[2] for x in segs])
+    return segment_transforms(a, b, r), np.concatenate([x[3] for x in segs])
+
+
+def _sphere_rows(parts: list[_Parts]) -> tuple[F64, F64]:
+    sph = [x for p in parts for x in p.spheres]
+    c = np.concatenate([x[0] for x in sph])
+    r = np.concatenate([x[1] for x in sph])
+    return sphere_transforms(c, r), np.concatenate([x[2] for x in sph])
+
+
+@dataclass(frozen=True)
+class _KitTable:
+    """The kit's moving parts, laid out once per geometry (pieces in the kit's order).
+
+    Cylinder rows: each drum's head, the hi-hat's bottom cymbal, each cymbal's
+    disc; sphere rows: each cymbal's bell.  Heads and the bottom hi-hat never
+    move (``cyl_base``); a frame writes the heads' colours and the cymbals'
+    transforms.
+    """
+
+    cyl_base: F64  # (n_cyl, 4, 4)
+    cyl_color: F64  # (n_cyl, 4)
+    drums: tuple[str, ...]
+    drum_rows: NDArray[np.intp]
+    cymbals: tuple[str, ...]
+    cymbal_rows: NDArray[np.intp]
+    centre: F64  # (n_cym, 3)
+    normal: F64  # (n_cym, 3)
+    swing_axis: F64  # (n_cym, 3) unit
+    radius: F64  # (n_cym,)
+    thickness: F64  # (n_cym,)
+    hihat: int  # index of the hi-hat among the cymbals, or -1
+
+
+_KIT_TABLES: dict[int, tuple[Geometry, _KitTable]] = {}
+
+
+def _kit_table(geo: Geometry) -> _KitTable:
+    hit = _KIT_TABLES.get(id(geo))
+    if hit is not None and hit[0] is geo:
+        return hit[1]
+    rows: list[F64] = []
+    colors: list[tuple[float, ...]] = []
+    drums: list[str] = []
+    drum_rows: list[int] = []
+    cymbals: list[str] = []
+    cymbal_rows: list[int] = []
+    cym: list[tuple[F64, F64, F64, float, float]] = []
+    hihat = -1
+    for name, piece in geo.kit.pieces.items():
         if isinstance(piece, Drum):
-            h = float(np.clip(pose.head_hits.get(name, 0.0), 0.0, 1.0))
-            color = tuple(np.array(HEAD) * (1 - h) + np.array(HEAD_HIT) * h)
-            disc = disc_transforms(
-                [piece.centre - piece.normal * 0.002], [piece.normal], piece.radius, 0.004
+            drums.append(name)
+            drum_rows.append(len(rows))
+            rows.append(
+                disc_transforms(
+                    [piece.centre - piece.normal * 0.002], [piece.normal], piece.radius, 0.004
+                )[0]
             )
-            dl.add("cylinder", disc, color)
+            colors.append(HEAD)
             continue
         assert isinstance(piece, Cymbal)
-        normal = piece.normal
-        angle = float(pose.cymbal_swing.get(name, 0.0))
-        if angle:
-            axis = np.cross(normal, np.array([0.0, 0.0, 1.0]))
-            if np.linalg.norm(axis) < 1e-6:
-                axis = np.array([1.0, 0.0, 0.0])
-            normal = _rotate(normal, axis / np.linalg.norm(axis), angle)
-        centre = piece.centre
+        centre = np.asarray(piece.centre, dtype=np.float64)
+        normal = np.asarray(piece.normal, dtype=np.float64)
         if name == "hihat":
             # the bottom cymbal stays; the top one rises off it as the pedal lets go
-            bottom = centre - np.array([0.0, 0.02, 0.0])
-            dl.add(
-                "cylinder",
-                disc_transforms([bottom], [piece.normal], piece.radius, piece.thickness),
-                BRASS,
+            hihat = len(cymbals)
+            centre = centre - np.array([0.0, 0.02, 0.0])
+            rows.append(disc_transforms([centre], [normal], piece.radius, piece.thickness)[0])
+            colors.append(BRASS)
+        axis = np.cross(normal, np.array([0.0, 0.0, 1.0]))
+        if np.linalg.norm(axis) < 1e-6:
+            axis = np.array([1.0, 0.0, 0.0])
+        cymbals.append(name)
+        cymbal_rows.append(len(rows))
+        rows.append(np.eye(4))
+        colors.append(BRASS)
+        cym.append((centre, normal, axis / np.linalg.norm(axis), piece.radius, piece.thickness))
+    table = _KitTable(
+        cyl_base=np.array(rows).reshape(-1, 4, 4),
+        cyl_color=np.array(colors, dtype=np.float64).reshape(-1, 4),
+        drums=tuple(drums),
+        drum_rows=np.array(drum_rows, dtype=np.intp),
+        cymbals=tuple(cymbals),
+        cymbal_rows=np.array(cymbal_rows, dtype=np.intp),
+        centre=np.array([c[0] for c in cym]).reshape(-1, 3),
+        normal=np.array([c[1] for c in cym]).reshape(-1, 3),
+        swing_axis=np.array([c[2] for c in cym]).reshape(-1, 3),
+        radius=np.array([c[3] for c in cym], dtype=np.float64),
+        thickness=np.array([c[4] for c in cym], dtype=np.float64),
+        hihat=hihat,
+    )
+    _KIT_TABLES[id(geo)] = (geo, table)
+    return table
+
+
+def _kit_rows(geo: Geometry, pose: BandPose) -> tuple[F64, F64, _Parts]:
+    """The kit's cylinder matrices and colours, and its bells as spheres."""
+    t = _kit_table(geo)
+    cyl = t.cyl_base.copy()
+    color = t.cyl_color.copy()
+    if t.drums:
+        hits = np.array([pose.head_hits.get(n, 0.0) for n in t.drums], dtype=np.float64)
+        h = np.clip(hits, 0.0, 1.0)[:, None]
+        color[t.drum_rows] = np.array(HEAD) * (1 - h) + np.array(HEAD_HIT) * h
+    if not t.cymbals:
+        return cyl, color, _Parts([], [])
+    angle = np.array([pose.cymbal_swing.get(n, 0.0) for n in t.cymbals], dtype=np.float64)
+    normal = _rotate_rows(t.normal, t.swing_axis, angle)
+    centre = t.centre.copy()
+    if t.hihat >= 0:
+        lift = 0.004 + 0.016 * float(np.clip(pose.hihat_open, 0.0, 1.0))
+        centre[t.hihat, 1] += lift
+    cyl[t.cymbal_rows] = disc_transforms(centre, normal, t.radius, t.thickness)
+    bells = _Parts([], [(centre, t.radius * 0.14, _rows(BRASS, len(centre)))])
+    return cyl, color, bells
+
+
+def _kit_dynamic(dl: DrawList, geo: Geometry, pose: BandPose) -> None:
+    cyl, color, bells = _kit_rows(geo, pose)
+    dl.add("cylinder", cyl, color)
+    if bells.spheres:
+        sph, sph_color = _sphere_rows([bells])
+        dl.add("sphere", sph, sph_color)
+
+
+def _rotate_rows(v: F64, axis: F64, angle: F64) -> F64:
+    """Rows of ``v`` (n, 3) turned by ``angle`` (n,) about unit ``axis`` rows (Rodrigues)."""
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    cross = _cross(axis, v)
+    dot = np.einsum("ij,ij->i", axis, v)[:, None]
+    out: F64 = v * c + cross * s + axis * dot * (1 - c)
+    return out
+
+
+@dataclass(frozen=True)
+class _StringTable:
+    nut: F64  # (n, 3)
+    bridge: F64  # (n, 3)
+    points: F64  # (n, max_fret + 1, 3): where each fret stops each string
+    radius: F64  # (n,)
+    lateral: F64  # (3,)
+    index: NDArray[np.float64]  # (n,) k of each string from the E string up (its rate)
+    _subsets: dict[tuple[int, ...], _StringTable]
+
+    def subset(self, rows: list[int]) -> _StringTable:
+        """The table of some strings (the tuning's), cached per choice."""
+        key = tuple(rows)
+        if key == tuple(range(len(self.nut))):
+            return self
+        hit = self._subsets.get(key)
+        if hit is None:
+            r = np.asarray(rows, dtype=np.intp)
+            hit = _StringTable(
+                self.nut[r],
+                self.bridge[r],
+                self.points[r],
+                self.radius[r],
+                self.lateral,
+                self.index[r],
+                {},
             )
-            lift = 0.004 + 0.016 * float(np.clip(pose.hihat_open, 0.0, 1.0))
-            centre = bottom + np.array([0.0, lift, 0.0])
-        dl.add(
-            "cylinder", disc_transforms([centre], [normal], piece.radius, piece.thickness), BRASS
-        )
-        dl.add("sphere", sphere_transforms([centre], piece.radius * 0.14), BRASS)  # the bell
+            self._subsets[key] = hit
+        return hit
 
 
-def _rotate(v: F64, axis: F64, angle: float) -> F64:
-    c, s = np.cos(angle), np.sin(angle)
-    return v * c + np.cross(axis, v) * s + axis * np.dot(axis, v) * (1 - c)
+_STRING_TABLES: dict[int, tuple[Geometry, _StringTable]] = {}
 
 
-def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) -> None:
-    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge.
-
-    The strings drawn are the pose's (the tuning's: four, five or six)."""
+def _string_table(geo: Geometry) -> _StringTable:
+    hit = _STRING_TABLES.get(id(geo))
+    if hit is not None and hit[0] is geo:
+        return hit[1]
     b = geo.bass
     lateral = np.cross(b.axis, b.front)
     lateral /= np.linalg.norm(lateral)
-    drawn = [s for s in b.strings if s in pose.string_vibration] or list(BASS_STRINGS)
-    for s in drawn:
-        k = b.strings.index(s) - b.strings.index("E")  # thinner from the E string up
-        a, z = b.nut[s], b.bridge[s]
-        amp = float(pose.string_vibration.get(s, 0.0))
-        radius = 0.0022 - 0.0003 * k
-        if amp <= 1e-5:
-            dl.add("cylinder", segment_transforms([a], [z], radius), STRING)
-            continue
-        fret = int(pose.string_stops.get(s, 0))
-        stop = b.string_point(s, min(max(fret, 0), b.max_fret))
-        dl.add("cylinder", segment_transforms([a], [stop], radius), STRING)
-        u = np.linspace(0.0, 1.0, segments + 1)[:, None]
-        pts = stop + u * (z - stop)
+    strings = list(b.strings)
+    k = np.arange(len(strings), dtype=np.float64) - strings.index("E")  # thinner from E up
+    table = _StringTable(
+        nut=np.array([b.nut[s] for s in strings], dtype=np.float64),
+        bridge=np.array([b.bridge[s] for s in strings], dtype=np.float64),
+        points=np.array(
+            [[b.string_point(s, f) for f in range(b.max_fret + 1)] for s in strings],
+            dtype=np.float64,
+        ),
+        radius=0.0022 - 0.0003 * k,
+        lateral=lateral,
+        index=k,
+        _subsets={},
+    )
+    _STRING_TABLES[id(geo)] = (geo, table)
+    return table
+
+
+def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) -> None:
+    seg, color = _segment_rows([_string_parts(geo, pose, segments)])
+    dl.add("cylinder", seg, color)
+
+
+def _string_parts(geo: Geometry, pose: BandPose, segments: int = 12) -> _Parts:
+    """Strings nut -> bridge; a vibrating one bows sideways between its stop and the bridge.
+
+    All strings in one batch: a still string is one segment nut -> bridge; a
+    vibrating one is nut -> its stop, then ``segments`` bowed pieces to the
+    bridge (rows in string order, as drawn one by one before)."""
+    full = _string_table(geo)
+    b = geo.bass
+    # the strings drawn are the pose's (the tuning's: four, five or six)
+    strings = [s for s in b.strings if s in pose.string_vibration] or list(BASS_STRINGS)
+    t = full.subset([b.strings.index(s) for s in strings])
+    amp = np.array([pose.string_vibration.get(s, 0.0) for s in strings], dtype=np.float64)
+    vib = amp > 1e-5
+    fret = np.array([pose.string_stops.get(s, 0) for s in strings], dtype=np.intp)
+    fret = np.clip(fret, 0, t.points.shape[1] - 1)
+    stop = t.points[np.arange(len(strings)), fret]
+    plain_end = np.where(vib[:, None], stop, t.bridge)
+    counts = 1 + segments * vib.astype(np.intp)
+    first = np.cumsum(counts) - counts  # each string's first row
+    n = int(counts.sum())
+    a = np.empty((n, 3))
+    z = np.empty((n, 3))
+    radius = np.empty(n)
+    color = np.empty((n, 4))
+    a[first] = t.nut
+    z[first] = plain_end
+    radius[first] = t.radius
+    color[first] = STRING
+    if vib.any():
+        v = np.flatnonzero(vib)
+        u, shape = _mode(segments)
+        pts = stop[v, None] + u * (t.bridge[v, None] - stop[v, None])
         # the fundamental mode of the vibrating part, swinging at a visible rate
-        swing = np.cos(2 * np.pi * (9.0 + 1.3 * k) * pose.time_s)
-        pts = pts + lateral * (amp * np.sin(np.pi * u) * swing)
-        dl.add("cylinder", segment_transforms(pts[:-1], pts[1:], radius * 1.3), STRING_HOT)
+        swing = np.cos(2 * np.pi * (9.0 + 1.3 * t.index[v]) * pose.time_s)
+        bow = amp[v, None] * shape * swing[:, None]
+        pts = pts + t.lateral * bow[..., None]
+        rows = (first[v, None] + 1 + np.arange(segments)[None, :]).reshape(-1)
+        a[rows] = pts[:, :-1].reshape(-1, 3)
+        z[rows] = pts[:, 1:].reshape(-1, 3)
+        radius[rows] = np.repeat(t.radius[v] * 1.3, segments)
+        color[rows] = STRING_HOT
+    return _Parts([(a, z, radius, color)], [])
+
+
+@cache
+def _mode(segments: int) -> tuple[F64, F64]:
+    """Points along a vibrating part (1, segments + 1, 1) and its mode shape sin(pi u)."""
+    u = np.linspace(0.0, 1.0, segments + 1)[None, :, None]
+    return u, np.sin(np.pi * u[..., 0])
+
+
+@dataclass(frozen=True)
+class _FigureTable:
+    """Index and colour arrays of one skeleton in one shirt (built once, not per frame)."""
+
+    limb_child: NDArray[np.intp]
+    limb_parent: NDArray[np.intp]
+    limb_color: F64
+    joints: NDArray[np.intp]
+    joint_color: F64
+    head: int  # -1 when the skeleton has no Head / HeadEnd
+    head_end: int
+
+
+@cache
+def _figure_table(
+    names: tuple[str, ...], parents: bytes, shirt: tuple[float, ...], skip: tuple[str, ...] = ()
+) -> _FigureTable:
+    """``parents``: the int64 parent indices' bytes (hashable, cheap to make each frame);
+    ``skip``: joints drawn otherwise (the bassist's hands, drawn with fingers)."""
+    par = np.frombuffer(parents, dtype=np.int64).astype(np.intp)
+    is_head = np.array([n.lower() in ("head", "headend") or n in skip for n in names], dtype=bool)
+    child = np.nonzero((par >= 0) & ~is_head)[0]
+    joints = np.nonzero(~is_head)[0]
+    has_head = "Head" in names and "HeadEnd" in names
+    return _FigureTable(
+        limb_child=child,
+        limb_parent=par[child],
+        limb_color=np.array([_limb_color(names[i], shirt) for i in child]).reshape(-1, 4),
+        joints=joints,
+        joint_color=np.array([_limb_color(names[i], shirt) for i in joints]).reshape(-1, 4),
+        head=names.index("Head") if has_head else -1,
+        head_end=names.index("HeadEnd") if has_head else -1,
+    )
 
 
 def _fingers(dl: DrawList, fig: FigurePose, bones: F64) -> None:
     """The bassist's finger bones (k, 2, 3) with a palm from each wrist to its knuckles."""
-    names = list(fig.names)
+    parts = [_finger_parts(fig, bones)]
+    seg, seg_color = _segment_rows(parts)
+    dl.add("cylinder", seg, seg_color)
+    sph, sph_color = _sphere_rows(parts)
+    dl.add("sphere", sph, sph_color)
+
+
+def _finger_parts(fig: FigurePose, bones: F64) -> _Parts:
+    names = fig.names
     pos = np.asarray(fig.positions, dtype=np.float64)
     half = LEFT_FINGER_BONES
-    for wrist, knuckles in (
-        ("LeftHand", bones[:8:2, 0]),
-        ("RightHand", bones[half : half + 4 : 2, 0]),
-    ):
-        if len(knuckles):
-            w = pos[names.index(wrist)]
-            dl.add("cylinder", segment_transforms([w], [knuckles.mean(axis=0)], 0.022), SKIN)
-    dl.add("cylinder", segment_transforms(bones[:, 0], bones[:, 1], 0.0075), SKIN)
-    dl.add("sphere", sphere_transforms(bones[:, 1], 0.008), SKIN)
+    palms = [
+        (pos[names.index(wrist)], knuckles.mean(axis=0))
+        for wrist, knuckles in (
+            ("LeftHand", bones[:8:2, 0]),
+            ("RightHand", bones[half : half + 4 : 2, 0]),
+        )
+        if len(knuckles)
+    ]
+    n, k = len(palms), len(bones)
+    segments: list[Segments] = []
+    if n:
+        a = np.array([p[0] for p in palms])
+        z = np.array([p[1] for p in palms])
+        segments.append((a, z, np.full(n, 0.022), _rows(SKIN, n)))
+    segments.append((bones[:, 0], bones[:, 1], np.full(k, 0.0075), _rows(SKIN, k)))
+    return _Parts(segments, [(bones[:, 1], np.full(k, 0.008), _rows(SKIN, k))])
 
 
 def _figure(
     dl: DrawList, fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ...] = ()
 ) -> None:
+    parts = [_figure_parts(fig, shirt, skip)]
+    seg, seg_color = _segment_rows(parts)
+    dl.add("cylinder", seg, seg_color)
+    sph, sph_color = _sphere_rows(parts)
+    dl.add("sphere", sph, sph_color)
+
+
+def _figure_parts(fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ...] = ()) -> _Parts:
+    """Limbs (parent joint -> joint) and joints of a figure; the head and its nose."""
     pos = np.asarray(fig.positions, dtype=np.float64)
-    parents = np.asarray(fig.parents)
     radii = np.asarray(fig.radii, dtype=np.float64)
-    names = list(fig.names)
-    is_head = np.array([n.lower() in ("head", "headend") or n in skip for n in names])
-    child = np.nonzero((parents >= 0) & ~is_head)[0]
-    colors = np.array([_limb_color(names[i], shirt) for i in child])
-    dl.add("cylinder", segment_transforms(pos[parents[child]], pos[child], radii[child]), colors)
-    joints = np.nonzero(~is_head)[0]
-    joint_colors = np.array([_limb_color(names[i], shirt) for i in joints])
-    dl.add("sphere", sphere_transforms(pos[joints], radii[joints] * 1.05), joint_colors)
-    if "Head" in names and "HeadEnd" in names:
+    t = _figure_table(tuple(fig.names), np.asarray(fig.parents).tobytes(), tuple(shirt), skip)
+    parts = _Parts(
+        [(pos[t.limb_parent], pos[t.limb_child], radii[t.limb_child], t.limb_color)],
+        [(pos[t.joints], radii[t.joints] * 1.05, t.joint_color)],
+    )
+    if t.head >= 0:
         # the head: one sphere between the base of the skull and its top, a nose to show where it looks
-        a, b = pos[names.index("Head")], pos[names.index("HeadEnd")]
-        centre = (a + b) / 2
-        dl.add("sphere", sphere_transforms([centre], 0.105), SKIN)
-        rot = np.asarray(fig.rotations)[names.index("Head")]
+        centre = (pos[t.head] + pos[t.head_end]) / 2
+        rot = np.asarray(fig.rotations)[t.head]
         forward = _quat_rotate(rot, np.array([0.0, 0.0, 1.0]))
-        dl.add("sphere", sphere_transforms([centre + forward * 0.1], 0.022), SKIN)
+        parts.spheres.append(
+            (np.stack([centre, centre + forward * 0.1]), np.array([0.105, 0.022]), _rows(SKIN, 2))
+        )
+    return parts
 
 
 def _quat_rotate(q: F64, v: F64) -> F64:
     """Rotate ``v`` (3,) by the unit quaternion ``q`` (w, x, y, z)."""
-    w, u = q[0], q[1:]
-    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
+    w, x, y, z = (float(c) for c in q)
+    a, b, c = (float(e) for e in v)
+    # t = u x v + w v, then v + 2 u x t (written out: this runs twice a frame)
+    tx, ty, tz = y * c - z * b + w * a, z * a - x * c + w * b, x * b - y * a + w * c
+    return np.array(
+        [a + 2.0 * (y * tz - z * ty), b + 2.0 * (z * tx - x * tz), c + 2.0 * (x * ty - y * tx)]
+    )
 
 
 def _limb_color(name: str, shirt: tuple[float, ...]) -> tuple[float, ...]:

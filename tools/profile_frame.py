@@ -44,7 +44,9 @@ def main() -> None:
     writer = VideoWriter(
         __import__("pathlib").Path("/tmp/virja-profile.mp4"), size, 30.0, bottom_up=True
     )
-    stages: dict[str, list[float]] = {k: [] for k in ("pose", "scene", "draw", "readback", "encode")}
+    stages: dict[str, list[float]] = {
+        k: [] for k in ("pose", "scene", "draw", "readback", "encode")
+    }
     prof = cProfile.Profile() if args.cprofile else None
     try:
         for t in times.tolist():

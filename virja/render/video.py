@@ -15,9 +15,9 @@ import shutil
 import subprocess
 import tempfile
 import threading
-from queue import Queue
 from collections.abc import Iterable
 from pathlib import Path
+from queue import Queue
 
 import mido
 import numpy as np

@@ -66,17 +66,16 @@ def main() -> None:
             e = time.perf_counter()
             writer.write_raw(raw)
             f = time.perf_counter()
-            for k, v in zip(stages, (b - a, c - b, d - c, e - d, f - e), strict=True):
-                v_ms = v * 1000
-                stages[k].append(v_ms)
+            for k, dt in zip(stages, (b - a, c - b, d - c, e - d, f - e), strict=True):
+                stages[k].append(dt * 1000)
     finally:
         writer.close()
         target.release()
         renderer.release()
         ctx.release()
     total = 0.0
-    for k, v in stages.items():
-        med = statistics.median(v[5:])
+    for k, ms in stages.items():
+        med = statistics.median(ms[5:])
         total += med
         print(f"{k:9s} {med:8.3f} ms median")
     print(f"{'sum':9s} {total:8.3f} ms  ({1000 / total:.1f} frames/s serial)")

@@ -32,6 +32,18 @@ class Figure:
     target: float
     higher_is_better: bool
     note: str = ""
+    load: float | None = None  # the reference workload's time now / on the quiet machine
+
+    @property
+    def ref_ratio(self) -> float | None:
+        """The ratio to the target with the figure corrected for the machine's load: a
+        CPU figure scaled by how much slower the reference workload ran in this run
+        than on the quiet machine (None for figures not timed on the CPU)."""
+        if self.load is None or self.value <= 0:
+            return None
+        load = max(self.load, 1.0)  # a faster machine is not credited
+        value = self.value * load if self.higher_is_better else self.value / load
+        return value / self.target if self.higher_is_better else self.target / value
 
     @property
     def ratio(self) -> float:
@@ -63,6 +75,33 @@ def machine() -> dict[str, Any]:
         "numpy": np.__version__,
         "system": f"{platform.system()} {platform.release()}",
     }
+
+
+# -- the reference: how loaded the machine is now ----------------------------------
+
+# reference_ms() on the project's machine (2 cores, no other job), median of 15 runs
+REFERENCE_QUIET_MS = 6.0
+
+
+def reference_ms(repeats: int = 7) -> float:
+    """A fixed single-thread workload of small numpy calls and Python (the kind of work
+    the per-frame path does), median ms: its ratio to :data:`REFERENCE_QUIET_MS`
+    says how much slower this machine runs now than when it was quiet."""
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal((64, 3))
+    b = rng.standard_normal((64, 3))
+    m = rng.standard_normal((48, 4, 4))
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        acc = 0.0
+        for _ in range(400):
+            c = np.cross(a, b)
+            n = np.sqrt(np.einsum("ij,ij->i", c, c))
+            acc += float((m @ m).sum()) + float(n.sum())
+            acc += sum(x * 0.5 for x in range(40))
+        times.append(time.perf_counter() - start)
+    return float(np.median(times)) * 1000
 
 
 # -- RMCP ---------------------------------------------------------------------
@@ -238,6 +277,109 @@ def pose_ms(frames: int = 600) -> float:
     return (time.perf_counter() - start) / frames * 1000
 
 
+def pose_scene_ms(frames: int = 600) -> tuple[float, float]:
+    """Pose (sampling, blending, FK) and scene building (instance tables) of the demo,
+    mean ms per frame each: the CPU part of a frame before GL."""
+    from virja.render.scene import band_scene
+
+    animator, t0, t1 = _demo_animator()
+    times = np.linspace(t0, t1, frames).tolist()
+    band_scene(animator.pose(times[0])).packed("cylinder")
+    pose_s = scene_s = 0.0
+    for t in times:
+        a = time.perf_counter()
+        pose = animator.pose(t)
+        b = time.perf_counter()
+        dl = band_scene(pose)
+        dl.packed("cylinder")
+        dl.packed("sphere")
+        scene_s += time.perf_counter() - b
+        pose_s += b - a
+    return pose_s / frames * 1000, scene_s / frames * 1000
+
+
+def gl_draw_ms(frames: int = 90, size: tuple[int, int] = (1280, 720)) -> float:
+    """GL time of one frame of the band (scenes built beforehand): draw until finished,
+    median ms."""
+    from virja.render.camera import PRESETS
+    from virja.render.hosts import OffscreenTarget, create_headless_context
+    from virja.render.renderer import Renderer
+    from virja.render.scene import band_scene, static_scene
+
+    animator, t0, t1 = _demo_animator()
+    scenes = [
+        band_scene(animator.pose(float(t))) for t in np.linspace(t0, min(t1, t0 + 8.0), frames)
+    ]
+    ctx = create_headless_context()
+    renderer = Renderer(ctx)
+    target = OffscreenTarget(ctx, size, samples=1)
+    static = static_scene()
+    cam = PRESETS["front"]
+    times = []
+    try:
+        renderer.draw([static, scenes[0]], cam, target.fbo)
+        target.finish()
+        for dl in scenes:
+            start = time.perf_counter()
+            renderer.draw([static, dl], cam, target.fbo)
+            target.finish()
+            times.append(time.perf_counter() - start)
+    finally:
+        target.release()
+        renderer.release()
+        ctx.release()
+    return float(np.median(times)) * 1000
+
+
+def offline_realtime_factor(seconds: float | None = None) -> tuple[float, float]:
+    """``virja render`` of the demo to an H.264 video with its sound, as a user runs it:
+    (music seconds / wall seconds, music seconds).  ``seconds`` renders only the first
+    part of the demo."""
+    import contextlib
+    import io
+    import tempfile
+
+    from virja.cli.main import main
+
+    duration = read_midi(demo_path()).duration_s
+    end = duration + 1.5 if seconds is None else min(seconds, duration + 1.5)
+    with tempfile.TemporaryDirectory(prefix="virja-bench-") as tmp:
+        argv = ["render", demo_path(), "--out", str(Path(tmp) / "demo.mp4"), "--end", f"{end}"]
+        start = time.perf_counter()
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            rc = main(argv)
+        wall = time.perf_counter() - start
+    if rc != 0:
+        return 0.0, end
+    return end / wall, end
+
+
+def jam_key_to_impact_ms(notes: int = 60) -> tuple[float, str]:
+    """Median key-to-impact of ``virja jam`` through JACK (tools/jack_latency.py
+    --impact, a checkout's tool with its own dummy JACK server): (ms, note);
+    NaN and why where it cannot run here."""
+    import re
+    import shutil
+    import subprocess
+    import sys
+
+    tool = Path(__file__).resolve().parent.parent / "tools" / "jack_latency.py"
+    if not tool.is_file():
+        return float("nan"), "not measured: tools/jack_latency.py is in a checkout only"
+    if shutil.which("jackd") is None:
+        return float("nan"), "not measured: no jackd (apt-get install jackd2)"
+    cmd = [sys.executable, str(tool), "--impact", "--notes", str(notes), "--gap-ms", "120"]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
+    except subprocess.TimeoutExpired:
+        return float("nan"), "not measured: the JACK run took over 120 s"
+    found = re.search(r"median ([0-9.]+) ms\s+p95 ([0-9.]+) ms\s+worst ([0-9.]+) ms", proc.stdout)
+    if proc.returncode != 0 or not found:
+        why = (proc.stderr.strip().splitlines() or ["no figure printed"])[-1][:200]
+        return float("nan"), f"not measured: {why}"
+    return float(found.group(1)), f"p95 {found.group(2)} ms, worst {found.group(3)} ms"
+
+
 def render_fps(
     seconds: float = 3.0,
     readback: bool = False,
@@ -277,35 +419,89 @@ def render_fps(
     return frames / elapsed, gl_name
 
 
+# render_fps at 1280x720 before the speed work (docs/performance.md, quiet median)
+RENDER_FPS_BEFORE = 78.1
+
+
 def run_all(
-    quick: bool = False, progress: Callable[[str], None] | None = None
+    quick: bool = False,
+    progress: Callable[[str], None] | None = None,
+    jam: bool = True,
+    offline: bool = True,
 ) -> tuple[dict[str, Any], list[Figure]]:
     say = progress or (lambda _msg: None)
     scale = 0.4 if quick else 1.0
     figs: list[Figure] = []
+    say("reference workload")
+    refs = [reference_ms()]
+
+    def load() -> float:
+        """The reference now (measured again before each figure) against the quiet one."""
+        refs.append(reference_ms(3))
+        return float(np.median(refs)) / REFERENCE_QUIET_MS
+
     say("rmcp decode")
+    lf = load()
     figs.append(
         Figure(
             "rmcp_datagrams_per_s",
             rmcp_decode_rate(int(40_000 * scale)),
             "datagrams/s",
-            20_000,
+            50_000,
             True,
+            load=lf,
         )
     )
     say("rmcp latency")
     p50, p99 = rmcp_latency_ms(int(1500 * scale))
     figs.append(Figure("rmcp_latency_ms_p99", p99, "ms", 2.0, False, f"p50 {p50:.3f} ms"))
     say("planning")
+    lf = load()
     pp50, pp99 = plan_beat_ms(int(300 * scale))
     s50, s99 = plan_streamed_ms(int(200 * scale))
     note = f"p50 {pp50:.3f} ms; streamed note by note: p50 {s50:.2f} ms, p99 {s99:.2f} ms per beat"
-    figs.append(Figure("plan_ms_p99", pp99, "ms", 2.0, False, note))
-    say("pose")
-    figs.append(Figure("pose_ms", pose_ms(int(600 * scale)), "ms/frame", 1.0, False))
+    figs.append(Figure("plan_ms_p99", pp99, "ms", 1.0, False, note, load=lf))
+    say("pose and scene")
+    lf = load()
+    pose, scene = pose_scene_ms(int(600 * scale))
+    figs.append(Figure("pose_ms", pose, "ms/frame", 1.0, False, load=lf))
+    figs.append(
+        Figure(
+            "pose_scene_ms",
+            pose + scene,
+            "ms/frame",
+            0.5,
+            False,
+            f"pose {pose:.3f} + scene {scene:.3f} ms",
+            load=lf,
+        )
+    )
+    say("GL draw")
+    figs.append(
+        Figure(
+            "gl_draw_ms",
+            gl_draw_ms(int(90 * scale)),
+            "ms/frame",
+            1000 / (1.5 * RENDER_FPS_BEFORE),
+            False,
+            "1280x720, drawn until finished, scenes built before",
+            load=load(),
+        )
+    )
     say("render")
     fps, gl_name = render_fps(3.0 * scale)
-    figs.append(Figure("render_fps", fps, "frames/s", 60.0, True, "1280x720, no MSAA, no readback"))
+    target_fps = 1.5 * RENDER_FPS_BEFORE
+    figs.append(
+        Figure(
+            "render_fps",
+            fps,
+            "frames/s",
+            target_fps,
+            True,
+            f"1280x720, no MSAA, no readback; 1.5x the {RENDER_FPS_BEFORE:g} fps before",
+            load=load(),
+        )
+    )
     say("render with readback")
     fps_rb, _ = render_fps(3.0 * scale, readback=True)
     figs.append(
@@ -313,10 +509,30 @@ def run_all(
             "render_fps_readback",
             fps_rb,
             "frames/s",
-            30.0,
+            target_fps,
             True,
             "1280x720, no MSAA, with readback as for video",
+            load=load(),
         )
     )
-    info = machine() | {"gl_renderer": gl_name}
+    if offline:
+        say("offline render of the demo with encoding")
+        lf = load()
+        rtf, music_s = offline_realtime_factor(8.0 if quick else None)
+        figs.append(
+            Figure(
+                "offline_realtime_factor",
+                rtf,
+                "x real time",
+                2.0,
+                True,
+                f"virja render of {music_s:.1f} s of the demo to .mp4 with sound, 1280x720, 30 fps",
+                load=lf,
+            )
+        )
+    if jam:
+        say("jam key to impact (JACK)")
+        k2i, why = jam_key_to_impact_ms(30 if quick else 60)
+        figs.append(Figure("jam_key_to_impact_ms", k2i, "ms", 35.0, False, why))
+    info = machine() | {"gl_renderer": gl_name, "reference_ms": round(float(np.median(refs)), 3)}
     return info, figs

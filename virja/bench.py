@@ -32,13 +32,13 @@ class Figure:
     target: float
     higher_is_better: bool
     note: str = ""
-    load: float | None = None  # the reference workload's time now / on the quiet machine
+    load: float | None = None  # the reference workload's wall over CPU time, near the figure
 
     @property
     def ref_ratio(self) -> float | None:
         """The ratio to the target with the figure corrected for the machine's load: a
-        CPU figure scaled by how much slower the reference workload ran in this run
-        than on the quiet machine (None for figures not timed on the CPU)."""
+        CPU figure scaled by how much of its wall time the reference workload spent
+        waiting for a core in this run (None for figures not corrected)."""
         if self.load is None or self.value <= 0:
             return None
         load = max(self.load, 1.0)  # a faster machine is not credited
@@ -79,29 +79,29 @@ def machine() -> dict[str, Any]:
 
 # -- the reference: how loaded the machine is now ----------------------------------
 
-# reference_ms() on the project's machine (2 cores, no other job), median of 15 runs
-REFERENCE_QUIET_MS = 6.0
 
-
-def reference_ms(repeats: int = 7) -> float:
+def reference_load(repeats: int = 7) -> tuple[float, float]:
     """A fixed single-thread workload of small numpy calls and Python (the kind of work
-    the per-frame path does), median ms: its ratio to :data:`REFERENCE_QUIET_MS`
-    says how much slower this machine runs now than when it was quiet."""
+    the per-frame path does): (median wall ms, load).  The load is its wall time over
+    the CPU time this thread got for it: 1.0 on an idle machine, 3.0 when the thread
+    waited for a core two thirds of the time (other jobs sharing the cores)."""
     rng = np.random.default_rng(0)
     a = rng.standard_normal((64, 3))
     b = rng.standard_normal((64, 3))
     m = rng.standard_normal((48, 4, 4))
-    times = []
+    walls, loads = [], []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         acc = 0.0
         for _ in range(400):
             c = np.cross(a, b)
             n = np.sqrt(np.einsum("ij,ij->i", c, c))
             acc += float((m @ m).sum()) + float(n.sum())
             acc += sum(x * 0.5 for x in range(40))
-        times.append(time.perf_counter() - start)
-    return float(np.median(times)) * 1000
+        wall, used = time.perf_counter() - start, time.thread_time() - cpu
+        walls.append(wall)
+        loads.append(wall / max(used, 1e-9))
+    return float(np.median(walls)) * 1000, max(float(np.median(loads)), 1.0)
 
 
 # -- RMCP ---------------------------------------------------------------------
@@ -433,12 +433,12 @@ def run_all(
     scale = 0.4 if quick else 1.0
     figs: list[Figure] = []
     say("reference workload")
-    refs = [reference_ms()]
+    refs = [reference_load()]
 
     def load() -> float:
-        """The reference now (measured again before each figure) against the quiet one."""
-        refs.append(reference_ms(3))
-        return float(np.median(refs)) / REFERENCE_QUIET_MS
+        """The machine's load now (the reference measured again before each figure)."""
+        refs.append(reference_load(3))
+        return refs[-1][1]
 
     say("rmcp decode")
     lf = load()
@@ -534,5 +534,9 @@ def run_all(
         say("jam key to impact (JACK)")
         k2i, why = jam_key_to_impact_ms(30 if quick else 60)
         figs.append(Figure("jam_key_to_impact_ms", k2i, "ms", 35.0, False, why))
-    info = machine() | {"gl_renderer": gl_name, "reference_ms": round(float(np.median(refs)), 3)}
+    info = machine() | {
+        "gl_renderer": gl_name,
+        "reference_ms": round(float(np.median([r[0] for r in refs])), 3),
+        "load": round(float(np.median([r[1] for r in refs])), 2),
+    }
     return info, figs

@@ -274,6 +274,7 @@ class VideoWriter:
         rc = self._proc.wait()
         if rc != 0:
             raise NotAvailableError(f"ffmpeg failed ({rc}): {self._stderr()}")
+        self._raise_failed()  # a frame the writer thread could not hand over
 
 
 def make_audio_track(

@@ -34,6 +34,7 @@ from virja.geometry import (
 from virja.motion import quat
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
+from virja.motion.drummer_body import BodySettings, DrummerBody
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
     LIMB_JOINTS,
@@ -187,6 +188,7 @@ class BandAnimator:
         library: MotionLibrary | None = None,
         geometry: Geometry = GEOMETRY,
         settings: AnimationSettings | None = None,
+        body: BodySettings | None = None,
     ) -> None:
         self.library = library if library is not None else default_library()
         self.geometry = geometry
@@ -205,6 +207,7 @@ class BandAnimator:
         pedal = geometry.kit.hihat_pedal
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
+        self.body = DrummerBody(self._roots[0], geometry, body)
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
 
@@ -264,6 +267,7 @@ class BandAnimator:
                 )
             )
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
+            self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
         elif p.performer == "bass":
             if p.string not in self.bass_strings:
                 raise UnknownMotionError(
@@ -315,6 +319,7 @@ class BandAnimator:
         """Drop what can no longer show at ``time_s`` or later (bounds memory in long sessions)."""
         for tl in self.timelines.values():
             tl.forget_before(time_s)
+        self.body.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
         k = bisect.bisect_left(self._hit_times, horizon)
@@ -340,6 +345,7 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
+        out[0] = self._body(np.array([time_s]), out[None, 0])[0]
         index, phase = self._beat_phase(time_s)
         out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
@@ -354,6 +360,16 @@ class BandAnimator:
             return i + int(phase), phase % 1.0
         spb = self.settings.reference_spb
         return int(math.floor(t / spb)), (t / spb) % 1.0
+
+    def _body(self, times: np.ndarray, drummer: np.ndarray) -> np.ndarray:
+        """The drummer's living body over the limbs (virja.motion.drummer_body)."""
+        return self.body.apply(
+            times,
+            drummer,
+            self._roots[0],
+            np.asarray(self._beat_times, dtype=np.float64),
+            np.asarray(self._beat_spb, dtype=np.float64),
+        )
 
     def _nod(self, t: float) -> np.ndarray:
         s = self.settings
@@ -415,6 +431,7 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
+        out[:, 0] = self._body(ts, out[:, 0])
         for k, t in enumerate(ts.tolist()):  # the bassist's body: per frame (IK, not batched)
             index, phase = self._beat_phase(t)
             out[k, 1] = self.bassist.body(out[k, 1], self._roots[1], t, phase, index)

@@ -60,6 +60,10 @@ class Performance:
         self.router = router
         self.planner = planner
         self.animator = animator
+        if animator is not None:  # hi-hat notes open and close the cymbals (the kit map says how)
+            animator.set_articulations(
+                {n: d.articulation for n, d in planner.config.kit.notes.items()}
+            )
         self.plan_log = plan_log
         self.counts: Counter[str] = Counter()
         self.planned: list[PlannedNote] = []

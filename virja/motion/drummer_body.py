@@ -11,7 +11,8 @@ stay where the clips put them:
   and never jumps).
 - **breathing**: the chest pitches slowly (``breath_deg`` at ``breath_period_s``).
 - **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
-  ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped).
+  ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
+  and the torso turns ``sway_deg`` one way on one beat, the other way on the next.
 - **arms**: while a hand is playing (within ``engage_s`` of one of its
   impacts) each arm is re-solved as a two-bone chain from its moved shoulder
   to the wrist of the authored pose, elbow toward the authored elbow, and the
@@ -64,6 +65,7 @@ class BodySettings:
     breath_deg: float = 0.8
     breath_period_s: float = 3.6
     beat_deg: float = 1.5
+    sway_deg: float = 2.0
     reference_spb: float = 0.5
     engage_s: float = 1.0
     release_s: float = 0.5
@@ -71,11 +73,11 @@ class BodySettings:
     @classmethod
     def still(cls) -> BodySettings:
         """No body layer at all: the limbs exactly as the clips put them (for tests of the clips)."""
-        return cls(gain=0.0, breath_deg=0.0, beat_deg=0.0)
+        return cls(gain=0.0, breath_deg=0.0, beat_deg=0.0, sway_deg=0.0)
 
     @property
     def is_still(self) -> bool:
-        return self.gain == 0.0 and self.breath_deg == 0.0 and self.beat_deg == 0.0
+        return self.gain == self.breath_deg == self.beat_deg == self.sway_deg == 0.0
 
     @classmethod
     def load(cls, path: Path | None = None) -> BodySettings:
@@ -96,6 +98,7 @@ class BodySettings:
             breath_deg=float(b["chest_deg"]),
             breath_period_s=float(b["period_s"]),
             beat_deg=float(d["beat"]["spine_deg"]),
+            sway_deg=float(d["beat"]["sway_deg"]),
             reference_spb=float(d["beat"]["reference_spb"]),
             engage_s=float(a["engage_s"]),
             release_s=float(a["release_s"]),
@@ -183,18 +186,39 @@ class DrummerBody:
         gap = np.minimum(np.abs(t - prev), np.abs(nxt - t))
         return np.asarray(np.clip((s.engage_s + s.release_s - gap) / s.release_s, 0.0, 1.0))
 
-    def _lean(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
+    def _beat_phase(
+        self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Phase in the current beat (0..1), seconds per beat, and +-1 alternating by beat."""
         s = self.settings
         i = np.searchsorted(beat_times, t, side="right") - 1
         if beat_times.size:
             k = np.maximum(i, 0)
             spb = beat_spb[k]
-            phase = np.where(i >= 0, np.minimum((t - beat_times[k]) / spb, 1.0), 0.0)
+            start = beat_times[k]
+            phase = np.where(i >= 0, np.minimum((t - start) / spb, 1.0), 0.0)
         else:
             spb = np.full(t.shape, s.reference_spb)
-            phase = np.mod(t / s.reference_spb, 1.0)
+            start = np.floor(t / spb) * spb
+            phase = np.mod(t / spb, 1.0)
+        # alternate by the beat's place on its tempo's grid; the sin^2 shapes below are
+        # 0 at every beat, so a tempo change that repeats a sign never makes a jump
+        sign = np.where(np.mod(np.round(start / spb), 2) == 0, 1.0, -1.0)
+        return phase, spb, sign
+
+    def _lean(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
+        """Forward lean (rad) on each beat."""
+        s = self.settings
+        phase, spb, _sign = self._beat_phase(t, beat_times, beat_spb)
         amp = np.radians(s.beat_deg) * np.clip(spb / s.reference_spb, 0.3, 1.5)
         return np.asarray(amp * np.sin(np.pi * phase) ** 2)
+
+    def _sway(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
+        """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
+        s = self.settings
+        phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
+        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, 0.5, 1.5)
+        return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
 
     # ------------------------------------------------------------------ apply
 
@@ -212,7 +236,7 @@ class DrummerBody:
         out = np.array(local, dtype=np.float64, copy=True)
         if s.is_still:
             return out
-        yaw = self.turn(t)
+        yaw = self.turn(t) + self._sway(t, beat_times, beat_spb)
         breath = np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
         lean = self._lean(t, beat_times, beat_spb)
         hips = out[:, _HIPS]

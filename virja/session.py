@@ -60,10 +60,9 @@ class Performance:
         self.router = router
         self.planner = planner
         self.animator = animator
-        if animator is not None:  # hi-hat notes open and close the cymbals (the kit map says how)
-            animator.set_articulations(
-                {n: d.articulation for n, d in planner.config.kit.notes.items()}
-            )
+        setter = getattr(animator, "set_articulations", None)
+        if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
+            setter({n: d.articulation for n, d in planner.config.kit.notes.items()})
         self.plan_log = plan_log
         self.counts: Counter[str] = Counter()
         self.planned: list[PlannedNote] = []

@@ -47,3 +47,12 @@ def test_animator_opens_the_cymbals_for_open_notes(library: MotionLibrary) -> No
     assert a.pose(1.0).hihat_open <= 0.15
     assert a.pose(1.5).hihat_open >= 0.3
     assert ARTICULATIONS[44] == "pedal"
+
+
+def test_the_shipped_kit_map_is_the_default(library: MotionLibrary) -> None:
+    """Any animator (the live window's process too) follows the notes without being told."""
+    a = BandAnimator(library)
+    a.add_planned(dataclasses.replace(drum("hihat_right_hand", 1.3, 1.5), note=46))
+    assert a.pose(1.5).hihat_open >= 0.3
+    a.add_planned(dataclasses.replace(drum("hihat_left_foot", 1.8, 2.0), note=44))
+    assert a.pose(2.0).hihat_open <= 0.15

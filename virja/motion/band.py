@@ -36,7 +36,7 @@ from virja.motion import quat
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings, DrummerBody
-from virja.motion.drummer_kit import HihatState
+from virja.motion.drummer_kit import HihatState, default_articulations
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
     LIMB_JOINTS,
@@ -219,7 +219,7 @@ class BandAnimator:
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
         self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
-        self.articulations: dict[int, str | None] = {}
+        self.articulations: dict[int, str | None] = default_articulations()
 
     def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
         """The kit map's articulation per drum note number (``PlanConfig.kit.notes``):

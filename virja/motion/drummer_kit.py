@@ -14,9 +14,32 @@ the caller falls back to the left toe on the pedal.
 from __future__ import annotations
 
 import bisect
+import tomllib
+from collections.abc import Mapping
 
 OPEN = frozenset({"open", "open_edge"})
 CLOSED = frozenset({"closed", "closed_edge", "pedal"})
+
+
+def default_articulations() -> dict[int, str | None]:
+    """Articulation per note number from the shipped kit map (motions/drum_kit.toml,
+    ``[notes]``), so every animator, in any process, opens the hi-hat by the notes;
+    a user's kit map replaces it through ``BandAnimator.set_articulations``.  The
+    file is validated by virja.plan.config; entries that do not parse are skipped."""
+    from virja.resources import motions_dir
+
+    try:
+        d = tomllib.loads((motions_dir() / "drum_kit.toml").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return {}
+    notes = d.get("notes", {})
+    out: dict[int, str | None] = {}
+    if isinstance(notes, Mapping):
+        for key, entry in notes.items():
+            if str(key).isdigit() and isinstance(entry, Mapping):
+                art = entry.get("articulation")
+                out[int(key)] = art if isinstance(art, str) else None
+    return out
 
 
 class HihatState:
@@ -65,4 +88,4 @@ class HihatState:
         return cur
 
 
-__all__ = ["HihatState", "OPEN", "CLOSED"]
+__all__ = ["HihatState", "OPEN", "CLOSED", "default_articulations"]

@@ -56,3 +56,13 @@ def test_the_shipped_kit_map_is_the_default(library: MotionLibrary) -> None:
     assert a.pose(1.5).hihat_open >= 0.3
     a.add_planned(dataclasses.replace(drum("hihat_left_foot", 1.8, 2.0), note=44))
     assert a.pose(2.0).hihat_open <= 0.15
+
+
+def test_a_foot_chick_lets_the_foot_open_the_cymbals_just_before() -> None:
+    h = HihatState()
+    h.add(2.0, "pedal")
+    h.add(3.0, "closed")  # a stick note: no chick
+    assert h.chick_weight(1.5) == 0.0
+    assert 0.0 < h.chick_weight(1.9) < 1.0
+    assert h.chick_weight(2.0) == 1.0
+    assert h.chick_weight(2.9) == 0.0

@@ -513,11 +513,12 @@ class BandAnimator:
         return self._hits[lo:hi]
 
     def _hihat_open(self, wpos: np.ndarray, t: float) -> float:
-        by_notes = self.hihat.openness(t)
-        if by_notes is not None:
-            return by_notes
         rise = float(wpos[self._ltoe, 1]) - self._hihat_pressed_y
-        return float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
+        by_foot = float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
+        by_notes = self.hihat.openness(t)
+        if by_notes is None:
+            return by_foot
+        return by_notes + self.hihat.chick_weight(t) * max(by_foot - by_notes, 0.0)
 
     def _swings(self, t: float) -> dict[str, float]:
         out = {}

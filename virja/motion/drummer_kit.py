@@ -7,7 +7,9 @@ Between notes the cymbals hold the last note's state; a change moves
 linearly over ``lead_s`` before the impact (the foot lifts or presses just
 ahead of the stroke), and an open hi-hat left alone closes again after
 ``hold_open_s`` (the foot comes back down to rest); before the first note
-they are closed.  With no articulated hi-hat note at all (no kit map given)
+they are closed.  Just before a pedal note (a foot chick) the cymbals follow
+the left foot's lift, weighted up to its impact, when the foot presses them
+shut.  With no articulated hi-hat note at all (no kit map given)
 the caller falls back to the left toe on the pedal.
 """
 
@@ -50,6 +52,7 @@ class HihatState:
         self.hold_open_s = hold_open_s
         self._times: list[float] = []
         self._open: list[float] = []
+        self._pedal: list[float] = []
 
     def add(self, time_s: float, articulation: str | None) -> None:
         """Record a hi-hat note; articulations other than open/closed/pedal are ignored."""
@@ -62,11 +65,23 @@ class HihatState:
         i = bisect.bisect_right(self._times, time_s)
         self._times.insert(i, time_s)
         self._open.insert(i, value)
+        if articulation == "pedal":
+            bisect.insort(self._pedal, time_s)
+
+    def chick_weight(self, t: float, window_s: float = 0.25) -> float:
+        """0..1, rising over ``window_s`` to a pedal note's impact: how much the foot's own
+        lift opens the cymbals (a foot chick opens them a little and shuts them on the beat)."""
+        i = bisect.bisect_left(self._pedal, t)
+        if i == len(self._pedal):
+            return 0.0
+        ahead = self._pedal[i] - t
+        return max(0.0, 1.0 - ahead / window_s)
 
     def forget_before(self, time_s: float) -> None:
         k = max(bisect.bisect_left(self._times, time_s - 10.0) - 1, 0)
         del self._times[:k]
         del self._open[:k]
+        del self._pedal[: bisect.bisect_left(self._pedal, time_s - 10.0)]
 
     def openness(self, t: float) -> float | None:
         """Openness at ``t``, or None when no note says (the pedal decides then)."""

@@ -103,3 +103,13 @@ def test_settings_load_from_the_table() -> None:
     s = BodySettings.load()
     assert s.gain > 0 and s.max_turn_deg > 3 and not s.is_still
     assert BodySettings.still().is_still
+
+
+def test_still_before_the_first_stroke(library: MotionLibrary) -> None:
+    """Nothing played yet: the drummer sits still (a waiting window shows no motion)."""
+    a = BandAnimator(library)
+    a.add_planned(drum("snare_left_hand", 9.8, 10.0))
+    early = a.local_rotations_many(np.arange(0.0, 8.0, 0.25))[:, 0]  # the drummer
+    body = [i for i, n in enumerate(SKELETON.names) if n not in ("Neck", "Head")]  # idle nod
+    assert np.abs(early[:, body] - early[0, body]).max() < 1e-12
+    assert np.ptp(_chest_yaw(a, np.arange(9.5, 12.0, 0.05))) > 0.5

@@ -21,7 +21,8 @@ stay where the clips put them:
   from its strokes a resting hand blends (over ``release_s``) to riding with
   the body: it breathes and sways instead of hanging frozen in space.
 
-The hips and legs are not moved (the feet stay on the pedals).  Constants:
+Before the first hand stroke the drummer sits still (the body wakes over the
+``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals).  Constants:
 motions/drummer_body.toml.  Everything is vectorised over times.
 """
 
@@ -236,9 +237,14 @@ class DrummerBody:
         out = np.array(local, dtype=np.float64, copy=True)
         if s.is_still:
             return out
-        yaw = self.turn(t) + self._sway(t, beat_times, beat_spb)
-        breath = np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
-        lean = self._lean(t, beat_times, beat_spb)
+        # before his first stroke the drummer sits still; the body wakes over the second before it
+        firsts = [h[0] for h in self._times.values() if h]
+        if not firsts:
+            return out
+        awake = np.clip(t - (min(firsts) - s.engage_s), 0.0, s.engage_s) / s.engage_s
+        yaw = awake * (self.turn(t) + self._sway(t, beat_times, beat_spb))
+        breath = awake * np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
+        lean = awake * self._lean(t, beat_times, beat_spb)
         hips = out[:, _HIPS]
         spine_turn = quat.from_axis_angle(_UP, yaw * (1.0 - s.chest_share))
         chest_turn = quat.from_axis_angle(_UP, yaw * s.chest_share)

@@ -60,6 +60,9 @@ class Performance:
         self.router = router
         self.planner = planner
         self.animator = animator
+        setter = getattr(animator, "set_articulations", None)
+        if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
+            setter({n: d.articulation for n, d in planner.config.kit.notes.items()})
         self.plan_log = plan_log
         self.counts: Counter[str] = Counter()
         self.planned: list[PlannedNote] = []

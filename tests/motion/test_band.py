@@ -10,6 +10,7 @@ from virja.geometry import BASS_STRINGS, GEOMETRY
 from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary, UnknownMotionError, default_library
+from virja.motion.drummer_body import BodySettings
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
 
@@ -18,6 +19,8 @@ DRUM_MOTIONS = [f"{p}_{h}" for p in HAND_PIECES for h in ("left_hand", "right_ha
     "kick_right_foot",
     "hihat_left_foot",
 ]
+# the limb layer alone: these tests check the clips and their connections
+STILL = BodySettings.still()
 TOL = 0.01  # 1 cm
 
 
@@ -31,7 +34,7 @@ def test_library_has_every_basic_motion(library: MotionLibrary) -> None:
 @pytest.mark.parametrize("motion", DRUM_MOTIONS)
 def test_drum_stroke_contact_within_1cm_at_impact(library: MotionLibrary, motion: str) -> None:
     clip = library[motion]
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     p = drum(motion, 1.0, 1.0 + clip.impact_s)
     a.add_planned(p)
     assert contact_distance(a, p, p.impact)[0] < TOL
@@ -40,7 +43,7 @@ def test_drum_stroke_contact_within_1cm_at_impact(library: MotionLibrary, motion
 @pytest.mark.parametrize("string", BASS_STRINGS)
 def test_every_fret_contact_within_1cm_at_impact(library: MotionLibrary, string: str) -> None:
     for fret in range(0, 21):
-        a = BandAnimator(library)
+        a = BandAnimator(library, body=STILL)
         p = bass(string, fret, 1.0, 1.2)
         a.add_planned(p)
         pluck, fretting = contact_distance(a, p, p.impact)
@@ -52,7 +55,7 @@ def test_every_fret_contact_within_1cm_at_impact(library: MotionLibrary, string:
 @pytest.mark.parametrize("prep_s", [0.06, 0.2, 0.6])
 def test_time_warp_keeps_start_and_impact(library: MotionLibrary, prep_s: float) -> None:
     """The clip's first frame shows at ``start`` and the contact lands at ``impact``."""
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     p = drum("snare_right_hand", 2.0, 2.0 + prep_s)
     a.add_planned(p)
     idle = library["idle_drums"].rotations[0]
@@ -86,7 +89,11 @@ def test_crossfade_only_inside_the_overlap(library: MotionLibrary) -> None:
     """Outside [B.start, A.end] the limb shows A alone or B alone, exactly."""
     pa = drum("snare_left_hand", 1.0, 1.25)
     pb = drum("tom_high_left_hand", 1.35, 1.65)
-    only_a, only_b, both = BandAnimator(library), BandAnimator(library), BandAnimator(library)
+    only_a, only_b, both = (
+        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL),
+    )
     only_a.add_planned(pa)
     only_b.add_planned(pb)
     both.add_planned(pa)
@@ -113,7 +120,11 @@ def test_crossfade_only_inside_the_overlap(library: MotionLibrary) -> None:
 def test_crossfade_weights_go_linearly_from_a_to_b(library: MotionLibrary) -> None:
     pa = drum("snare_left_hand", 1.0, 1.25)
     pb = drum("tom_high_left_hand", 1.35, 1.65)
-    a, oa, ob = BandAnimator(library), BandAnimator(library), BandAnimator(library)
+    a, oa, ob = (
+        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL),
+    )
     for an, ps in ((a, (pa, pb)), (oa, (pa,)), (ob, (pb,))):
         for p in ps:
             an.add_planned(p)
@@ -129,7 +140,7 @@ def test_fast_repeat_keeps_both_impacts(library: MotionLibrary) -> None:
     """B starts before A's impact: the connection waits for A's impact, both land."""
     pa = drum("snare_right_hand", 1.0, 1.2)
     pb = drum("snare_right_hand", 1.1, 1.3)
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     a.add_planned(pa)
     a.add_planned(pb)
     assert contact_distance(a, pa, pa.impact)[0] < TOL
@@ -148,7 +159,7 @@ def test_limb_masks_are_independent(
     library: MotionLibrary, performer: str, limb: str, note: object
 ) -> None:
     """A motion of one limb changes that limb's joints only (and never the other figure)."""
-    base, moved = BandAnimator(library), BandAnimator(library)
+    base, moved = BandAnimator(library, body=STILL), BandAnimator(library, body=STILL)
     base.add_planned(drum("snare_left_hand", 1.0, 1.25))
     moved.add_planned(drum("snare_left_hand", 1.0, 1.25))
     moved.add_planned(note)  # type: ignore[arg-type]
@@ -165,9 +176,9 @@ def test_limb_masks_are_independent(
 def test_bass_hands_are_independent(library: MotionLibrary) -> None:
     """The plucking hand goes where its clip says whatever the fretting hand does (the
     body follows the fretting hand, and the arms are solved again to keep both hands)."""
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     a.add_planned(bass("A", 5, 1.0, 1.2))
-    b = BandAnimator(library)
+    b = BandAnimator(library, body=STILL)
     b.add_planned(bass("A", 0, 1.0, 1.2))  # open string: the right hand alone moves
     tip = SKELETON.index("RightHandEnd")
     for t in np.arange(0.95, 1.6, 0.02):
@@ -178,7 +189,7 @@ def test_bass_hands_are_independent(library: MotionLibrary) -> None:
 def test_soft_stroke_is_smaller_but_still_lands(library: MotionLibrary) -> None:
     heights = []
     for vel in (30, 127):
-        a = BandAnimator(library)
+        a = BandAnimator(library, body=STILL)
         p = drum("snare_right_hand", 1.0, 1.3, velocity=vel)
         a.add_planned(p)
         assert contact_distance(a, p, p.impact)[0] < TOL
@@ -189,7 +200,7 @@ def test_soft_stroke_is_smaller_but_still_lands(library: MotionLibrary) -> None:
 def test_faster_tempo_shortens_the_rebound(library: MotionLibrary) -> None:
     from virja.events import Beat
 
-    slow, fast = BandAnimator(library), BandAnimator(library)
+    slow, fast = BandAnimator(library, body=STILL), BandAnimator(library, body=STILL)
     fast.add_beat(Beat(0.0, 0, 1, 4, 0, 250_000))  # 240 bpm
     for a in (slow, fast):
         a.add_planned(drum("snare_right_hand", 1.0, 1.3))
@@ -198,7 +209,7 @@ def test_faster_tempo_shortens_the_rebound(library: MotionLibrary) -> None:
 
 
 def test_kit_state_follows_the_strokes(library: MotionLibrary) -> None:
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     a.add_planned(drum("snare_left_hand", 1.0, 1.25, velocity=127))
     a.add_planned(drum("crash_right_hand", 1.0, 1.4))
     a.add_planned(drum("hihat_left_foot", 1.0, 1.2))
@@ -216,7 +227,7 @@ def test_kit_state_follows_the_strokes(library: MotionLibrary) -> None:
 
 
 def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:
-    p = BandAnimator(library).pose(0.0)
+    p = BandAnimator(library, body=STILL).pose(0.0)
     n = SKELETON.n_joints
     for fig in (p.drums, p.bass):
         assert fig.positions.shape == (n, 3) and fig.rotations.shape == (n, 4)
@@ -229,7 +240,7 @@ def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:
 
 
 def test_forget_before_bounds_memory(library: MotionLibrary) -> None:
-    a = BandAnimator(library)
+    a = BandAnimator(library, body=STILL)
     for i in range(400):
         t = 1.0 + 0.25 * i
         a.add_planned(drum("snare_left_hand" if i % 2 else "snare_right_hand", t - 0.2, t))
@@ -243,7 +254,7 @@ def test_forget_before_bounds_memory(library: MotionLibrary) -> None:
 
 def test_unknown_motion_raises(library: MotionLibrary) -> None:
     with pytest.raises(UnknownMotionError, match="cowbell"):
-        BandAnimator(library).add_planned(drum("cowbell_left_hand", 1.0, 1.2))
+        BandAnimator(library, body=STILL).add_planned(drum("cowbell_left_hand", 1.0, 1.2))
 
 
 def test_default_library_is_shared() -> None:

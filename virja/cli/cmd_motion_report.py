@@ -100,6 +100,7 @@ def run(args: argparse.Namespace) -> int:
     progress = Stage(len(planned), args.max_seconds)
     animator = BandAnimator()
     animator.use_bass_strings(tuple(name for name, _ in config.bass.strings))
+    animator.set_articulations({n: d.articulation for n, d in config.kit.notes.items()})
     for beat in session.beats:
         animator.add_beat(beat)
     for p in planned:

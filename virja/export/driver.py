@@ -105,6 +105,9 @@ def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None =
     kick = GEOMETRY.kit.kick_pedal
     up_y, down_y = float(kick.toe_point(False)[1]), float(kick.toe_point(True)[1])
     toe = np.array([p.drums.position("RightToe")[1] for p in poses])
+    hh = GEOMETRY.kit.hihat_pedal  # its footboard follows the left foot; the cymbals the notes
+    hh_up, hh_dn = float(hh.toe_point(False)[1]), float(hh.toe_point(True)[1])
+    ltoe = np.array([p.drums.position("LeftToe")[1] for p in poses])
     return Sampled(
         times=np.asarray(times, dtype=np.float64),
         local=local,
@@ -114,6 +117,7 @@ def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None =
         },
         hihat_open=np.array([p.hihat_open for p in poses]),
         kick_down=np.clip((up_y - toe) / max(up_y - down_y, 1e-6), 0.0, 1.0),
+        hihat_down=np.clip((hh_up - ltoe) / max(hh_up - hh_dn, 1e-6), 0.0, 1.0),
         string_vibration={
             s: np.array([p.string_vibration.get(s, 0.0) for p in poses]) for s in BASS_STRINGS
         },

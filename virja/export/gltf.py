@@ -78,7 +78,9 @@ class Sampled:
     - ``roots``: (2, 3) root (hips) positions of the two figures;
     - ``cymbal_swing``: piece -> (m,) radians; ``hihat_open``: (m,) 0..1;
     - ``kick_down``: (m,) 0 (pedal up) .. 1 (pressed), from the right foot;
-    - ``string_vibration``: string -> (m,) metres.
+    - ``string_vibration``: string -> (m,) metres;
+    - ``hihat_down``: (m,) 0 (pedal up) .. 1 (pressed), from the left foot (None:
+      ``1 - hihat_open``).
     """
 
     times: F64
@@ -88,6 +90,7 @@ class Sampled:
     hihat_open: F64
     kick_down: F64
     string_vibration: dict[str, F64]
+    hihat_down: F64 | None = None
 
 
 # ---------------------------------------------------------------- unit meshes
@@ -576,7 +579,8 @@ def _kit(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _Anim) -> 
             mesh=b.mesh("cylinder", "brass"),
         )
         b.ball(f"kit_{name}_bell", node, np.zeros(3), piece.radius * 0.14, "brass")
-    for pedal, down in ((kit.kick_pedal, s.kick_down), (kit.hihat_pedal, 1.0 - s.hihat_open)):
+    hihat_down = 1.0 - s.hihat_open if s.hihat_down is None else s.hihat_down
+    for pedal, down in ((kit.kick_pedal, s.kick_down), (kit.hihat_pedal, hihat_down)):
         d = np.clip(np.asarray(down, dtype=np.float64), 0.0, 1.0)[:, None]
         board = (1 - d) * pedal.board + d * pedal.pressed_board
         rot = quat.from_two_vectors(np.broadcast_to(Z, board.shape), board)

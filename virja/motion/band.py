@@ -15,6 +15,7 @@ import bisect
 import logging
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -34,6 +35,8 @@ from virja.geometry import (
 from virja.motion import quat
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
+from virja.motion.drummer_body import BodySettings, DrummerBody
+from virja.motion.drummer_kit import HihatState, default_articulations
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
     LIMB_JOINTS,
@@ -111,6 +114,8 @@ class AnimationSettings:
         ("hihat", 0.03, 0.3, 3.0),
     )
     hihat_travel_m: float = 0.04
+    hihat_lead_s: float = 0.06
+    hihat_hold_open_s: float = 1.0
     string_amp_m: float = 0.004
     string_decay_s: float = 1.2
     bassist: BassistSettings = BassistSettings()
@@ -145,6 +150,8 @@ class AnimationSettings:
                 head_decay_s=float(k["head_decay_s"]),
                 swing=tuple(_swing(p, k[f"{p}_swing"]) for p in ("ride", "crash", "hihat")),
                 hihat_travel_m=float(k["hihat_travel_m"]),
+                hihat_lead_s=float(k.get("hihat_lead_s", cls.hihat_lead_s)),
+                hihat_hold_open_s=float(k.get("hihat_hold_open_s", cls.hihat_hold_open_s)),
                 string_amp_m=float(d["strings"]["amplitude_m"]),
                 string_decay_s=float(d["strings"]["decay_s"]),
                 bassist=BassistSettings.from_table(d.get("bassist", {})),
@@ -159,6 +166,8 @@ class AnimationSettings:
             "idle.sway_period_s": settings.sway_period_s,
             "kit.head_decay_s": settings.head_decay_s,
             "strings.decay_s": settings.string_decay_s,
+            "kit.hihat_lead_s": settings.hihat_lead_s,
+            "kit.hihat_hold_open_s": settings.hihat_hold_open_s,
         }
         for name, value in positive.items():
             if not (math.isfinite(value) and value > 0):
@@ -187,6 +196,7 @@ class BandAnimator:
         library: MotionLibrary | None = None,
         geometry: Geometry = GEOMETRY,
         settings: AnimationSettings | None = None,
+        body: BodySettings | None = None,
     ) -> None:
         self.library = library if library is not None else default_library()
         self.geometry = geometry
@@ -205,8 +215,16 @@ class BandAnimator:
         pedal = geometry.kit.hihat_pedal
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
+        self.body = DrummerBody(self._roots[0], geometry, body)
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
+        self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
+        self.articulations: dict[int, str | None] = default_articulations()
+
+    def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
+        """The kit map's articulation per drum note number (``PlanConfig.kit.notes``):
+        hi-hat notes then open and close the cymbals (virja.motion.drummer_kit)."""
+        self.articulations = dict(articulations)
 
     def use_bass_strings(self, strings: tuple[str, ...]) -> None:
         """The strings of the bass's tuning, low to high (four by default; B E A D G for a
@@ -264,6 +282,9 @@ class BandAnimator:
                 )
             )
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
+            self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
+            if (clip.piece or p.piece) == "hihat":
+                self.hihat.add(p.impact, self.articulations.get(getattr(p, "note", -1)))
         elif p.performer == "bass":
             if p.string not in self.bass_strings:
                 raise UnknownMotionError(
@@ -315,6 +336,8 @@ class BandAnimator:
         """Drop what can no longer show at ``time_s`` or later (bounds memory in long sessions)."""
         for tl in self.timelines.values():
             tl.forget_before(time_s)
+        self.body.forget_before(time_s)
+        self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
         k = bisect.bisect_left(self._hit_times, horizon)
@@ -340,6 +363,7 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
+        out[0] = self._body(np.array([time_s]), out[None, 0])[0]
         index, phase = self._beat_phase(time_s)
         out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
@@ -354,6 +378,16 @@ class BandAnimator:
             return i + int(phase), phase % 1.0
         spb = self.settings.reference_spb
         return int(math.floor(t / spb)), (t / spb) % 1.0
+
+    def _body(self, times: np.ndarray, drummer: np.ndarray) -> np.ndarray:
+        """The drummer's living body over the limbs (virja.motion.drummer_body)."""
+        return self.body.apply(
+            times,
+            drummer,
+            self._roots[0],
+            np.asarray(self._beat_times, dtype=np.float64),
+            np.asarray(self._beat_spb, dtype=np.float64),
+        )
 
     def _nod(self, t: float) -> np.ndarray:
         s = self.settings
@@ -384,7 +418,7 @@ class BandAnimator:
             drums=figs[0],
             bass=figs[1],
             sticks=sticks(wpos[0], wrot[0]),
-            hihat_open=self._hihat_open(wpos[0]),
+            hihat_open=self._hihat_open(wpos[0], time_s),
             cymbal_swing=self._swings(time_s),
             head_hits=self._head_hits(time_s),
             string_vibration=self._strings(time_s),
@@ -415,6 +449,7 @@ class BandAnimator:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
+        out[:, 0] = self._body(ts, out[:, 0])
         for k, t in enumerate(ts.tolist()):  # the bassist's body: per frame (IK, not batched)
             index, phase = self._beat_phase(t)
             out[k, 1] = self.bassist.body(out[k, 1], self._roots[1], t, phase, index)
@@ -460,7 +495,7 @@ class BandAnimator:
                     drums=figs[0],
                     bass=figs[1],
                     sticks=all_sticks[k],
-                    hihat_open=self._hihat_open(p[0]),
+                    hihat_open=self._hihat_open(p[0], t),
                     cymbal_swing=self._swings(t),
                     head_hits=self._head_hits(t),
                     string_vibration=self._strings(t),
@@ -477,9 +512,13 @@ class BandAnimator:
         hi = bisect.bisect_right(self._hit_times, t)
         return self._hits[lo:hi]
 
-    def _hihat_open(self, wpos: np.ndarray) -> float:
+    def _hihat_open(self, wpos: np.ndarray, t: float) -> float:
         rise = float(wpos[self._ltoe, 1]) - self._hihat_pressed_y
-        return float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
+        by_foot = float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
+        by_notes = self.hihat.openness(t)
+        if by_notes is None:
+            return by_foot
+        return by_notes + self.hihat.chick_weight(t) * max(by_foot - by_notes, 0.0)
 
     def _swings(self, t: float) -> dict[str, float]:
         out = {}

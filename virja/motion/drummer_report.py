@@ -86,14 +86,14 @@ def _sample(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Drummer joint positions (k, n, 3), rotations (k, n, 4), sticks (k, 2, 2, 3) and
     hi-hat openness (k,) at ``times``."""
-    pos, rot, stk, hh = [], [], [], []
-    for t in times:
-        wpos, wrot = _SK.fk(animator.local_rotations(float(t)), animator._roots)
-        pos.append(wpos[0])
-        rot.append(wrot[0])
-        stk.append(sticks(wpos[0], wrot[0]))
-        hh.append(animator._hihat_open(wpos[0]))
-    return np.array(pos), np.array(rot), np.array(stk), np.array(hh)
+    pos, rot = [], []
+    for k in range(0, len(times), 512):  # batched (local_rotations_many), bounded memory
+        wpos, wrot = _SK.fk(animator.local_rotations_many(times[k : k + 512]), animator._roots)
+        pos.append(wpos[:, 0])
+        rot.append(wrot[:, 0])
+    p, r = np.concatenate(pos), np.concatenate(rot)
+    hh = [animator._hihat_open(p[k], float(t)) for k, t in enumerate(times)]
+    return p, r, sticks(p, r), np.array(hh)
 
 
 def _runs(flags: np.ndarray) -> int:
@@ -197,7 +197,7 @@ def measure_drummer(
         if not want_closed and art not in OPEN_ARTICULATIONS:
             continue
         wpos, _w = _SK.fk(animator.local_rotations(p.impact), animator._roots)
-        openness = animator._hihat_open(wpos[0])
+        openness = animator._hihat_open(wpos[0], p.impact)
         fig.hihat_notes += 1
         if (openness <= CLOSED_MAX) if want_closed else (openness >= OPEN_MIN):
             fig.hihat_agreeing += 1

@@ -1,0 +1,115 @@
+"""The drummer's living body: the torso turns and breathes, the sticks stay where the clips put them."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tests.motion.helpers import drum
+from virja.events import Beat
+from virja.motion.band import BandAnimator
+from virja.motion.clip import MotionLibrary
+from virja.motion.drummer_body import BodySettings
+from virja.motion.drummer_report import _yaw_deg
+from virja.motion.skeleton import SKELETON
+
+_CHEST = SKELETON.index("Chest")
+
+
+def _groove(a: BandAnimator, right: str, left: str, n: int = 8, spb: float = 0.5) -> None:
+    for k in range(n):
+        t = 1.0 + k * spb
+        a.add_beat(Beat(t, k // 4, k % 4 + 1, 4, 0, round(spb * 1e6)))
+        a.add_planned(drum(f"{right}_right_hand", t - 0.2, t))
+        a.add_planned(drum(f"{left}_left_hand", t + spb / 2 - 0.2, t + spb / 2))
+
+
+def _chest_yaw(a: BandAnimator, times: np.ndarray) -> np.ndarray:
+    return _yaw_deg(np.stack([p.drums.rotations[_CHEST] for p in a.poses(times)]))
+
+
+def test_torso_turns_toward_the_pieces_played(library: MotionLibrary) -> None:
+    ride, hihat = BandAnimator(library), BandAnimator(library)
+    _groove(ride, "ride", "snare")
+    _groove(hihat, "hihat", "snare")
+    times = np.arange(2.0, 4.5, 0.05)
+    y_ride, y_hihat = _chest_yaw(ride, times), _chest_yaw(hihat, times)
+    # the ride is on the drummer's right (-x), the hi-hat on his left (+x)
+    assert y_ride.mean() < -3.0
+    assert y_hihat.mean() > 3.0
+    assert (y_hihat.mean() - y_ride.mean()) > 6.0
+
+
+def test_sticks_stay_where_the_clips_put_them(library: MotionLibrary) -> None:
+    """While a hand plays, its grip and stick are the clip's exactly (the arm is re-solved)."""
+    live = BandAnimator(library)
+    still = BandAnimator(library, body=BodySettings.still())
+    for a in (live, still):
+        _groove(a, "ride", "snare", spb=0.4)
+    times = np.arange(0.9, 4.6, 1 / 60)
+    pl, ps = live.poses(times), still.poses(times)
+    err = max(float(np.abs(x.sticks - y.sticks).max()) for x, y in zip(pl, ps, strict=True))
+    assert err < 1e-6
+    assert np.abs(_yaw_deg(np.stack([x.drums.rotations[_CHEST] for x in pl]))).max() > 3.0
+
+
+def test_the_turn_is_smooth(library: MotionLibrary) -> None:
+    a = BandAnimator(library)
+    for k in range(6):  # the right hand goes ride, crash, ride...: the target jumps
+        piece = "crash" if k % 2 else "ride"
+        a.add_planned(drum(f"{piece}_right_hand", 1.0 + k * 0.6 - 0.2, 1.0 + k * 0.6))
+    t = np.arange(0.5, 5.0, 1 / 120)
+    yaw = np.degrees(a.body.turn(t))
+    assert np.ptp(yaw) > 3.0
+    assert np.abs(np.diff(yaw)).max() < 0.5  # < 60 deg/s at 120 fps
+
+
+def test_a_resting_hand_breathes_with_the_body(library: MotionLibrary) -> None:
+    """Long after its last stroke a hand moves with the torso instead of hanging frozen."""
+    a = BandAnimator(library)
+    a.add_planned(drum("snare_left_hand", 0.8, 1.0))
+    times = np.arange(5.0, 9.0, 0.1)
+    wrist = SKELETON.index("LeftHand")
+    pos = np.stack([p.drums.positions[wrist] for p in a.poses(times)])
+    assert np.ptp(pos, axis=0).max() > 0.003
+    still = BandAnimator(library, body=BodySettings.still())
+    still.add_planned(drum("snare_left_hand", 0.8, 1.0))
+    pos0 = np.stack([p.drums.positions[wrist] for p in still.poses(times)])
+    assert np.ptp(pos0, axis=0).max() < 1e-9
+
+
+def test_beat_lean_is_smaller_when_faster(library: MotionLibrary) -> None:
+    def lean_range(spb: float) -> float:
+        a = BandAnimator(library)
+        t0 = 1.0
+        for k in range(8):
+            a.add_beat(Beat(t0 + k * spb, k // 4, k % 4 + 1, 4, 0, round(spb * 1e6)))
+        t = np.arange(t0, t0 + 4 * spb, 0.01)
+        return float(np.ptp(a.body._lean(t, np.asarray(a._beat_times), np.asarray(a._beat_spb))))
+
+    assert lean_range(0.5) > 1.5 * lean_range(0.2)
+
+
+def test_single_and_batched_poses_agree(library: MotionLibrary) -> None:
+    a = BandAnimator(library)
+    _groove(a, "ride", "snare", n=4)
+    times = np.array([1.1, 1.7, 2.35, 3.0])
+    many = a.local_rotations_many(times)
+    for k, t in enumerate(times):
+        one = a.local_rotations(float(t))
+        assert np.allclose(np.abs(np.sum(one * many[k], axis=-1)), 1.0, atol=1e-9)
+
+
+def test_settings_load_from_the_table() -> None:
+    s = BodySettings.load()
+    assert s.gain > 0 and s.max_turn_deg > 3 and not s.is_still
+    assert BodySettings.still().is_still
+
+
+def test_still_before_the_first_stroke(library: MotionLibrary) -> None:
+    """Nothing played yet: the drummer sits still (a waiting window shows no motion)."""
+    a = BandAnimator(library)
+    a.add_planned(drum("snare_left_hand", 9.8, 10.0))
+    early = a.local_rotations_many(np.arange(0.0, 8.0, 0.25))[:, 0]  # the drummer
+    body = [i for i, n in enumerate(SKELETON.names) if n not in ("Neck", "Head")]  # idle nod
+    assert np.abs(early[:, body] - early[0, body]).max() < 1e-12
+    assert np.ptp(_chest_yaw(a, np.arange(9.5, 12.0, 0.05))) > 0.5

@@ -1,0 +1,318 @@
+"""The drummer's living body (issue 15, deliverable 5): a turning torso that breathes.
+
+The hand and foot clips are authored in world space with a still torso.  This
+layer moves the torso over them and then re-solves the arms so the hands
+stay where the clips put them:
+
+- **turn**: the spine and chest turn (yaw) toward the pieces the two hands
+  play: a step function of time (at each stroke's impact the hand's piece
+  changes) averaged over both hands, scaled by ``gain`` and clamped, then
+  smoothed by a centred moving average (so the turn starts before the stroke
+  and never jumps).
+- **breathing**: the chest pitches slowly (``breath_deg`` at ``breath_period_s``).
+- **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
+  ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
+  and the torso turns ``sway_deg`` one way on one beat, the other way on the next.
+- **arms**: while a hand is playing (within ``engage_s`` of one of its
+  impacts) each arm is re-solved as a two-bone chain from its moved shoulder
+  to the wrist of the authored pose, elbow toward the authored elbow, and the
+  hand keeps its authored world rotation: the grip and the stick are where
+  the clip put them, so contact and timing at impact are unchanged.  Further
+  from its strokes a resting hand blends (over ``release_s``) to riding with
+  the body: it breathes and sways instead of hanging frozen in space.
+
+Before the first hand stroke the drummer sits still (the body wakes over the
+``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals).  Constants:
+motions/drummer_body.toml.  Everything is vectorised over times.
+"""
+
+from __future__ import annotations
+
+import bisect
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from virja.geometry import GEOMETRY, Geometry
+from virja.motion import quat
+from virja.motion.skeleton import SKELETON
+
+_SK = SKELETON
+_HIPS = _SK.index("Hips")
+_SPINE = _SK.index("Spine")
+_CHEST = _SK.index("Chest")
+_NECK = _SK.index("Neck")
+HANDS = ("left_hand", "right_hand")
+_ARMS = {
+    "left_hand": tuple(_SK.index(f"Left{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
+    "right_hand": tuple(_SK.index(f"Right{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
+}
+_UP = np.array([0.0, 1.0, 0.0])
+_SIDE = np.array([1.0, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class BodySettings:
+    """Constants from motions/drummer_body.toml (reasons given there)."""
+
+    gain: float = 0.45
+    max_turn_deg: float = 12.0
+    smooth_s: float = 0.5
+    chest_share: float = 0.5
+    head_share: float = 0.5
+    breath_deg: float = 0.8
+    breath_period_s: float = 3.6
+    beat_deg: float = 1.5
+    sway_deg: float = 2.0
+    reference_spb: float = 0.5
+    engage_s: float = 1.0
+    release_s: float = 0.5
+
+    @classmethod
+    def still(cls) -> BodySettings:
+        """No body layer at all: the limbs exactly as the clips put them (for tests of the clips)."""
+        return cls(gain=0.0, breath_deg=0.0, beat_deg=0.0, sway_deg=0.0)
+
+    @property
+    def is_still(self) -> bool:
+        return self.gain == self.breath_deg == self.beat_deg == self.sway_deg == 0.0
+
+    @classmethod
+    def load(cls, path: Path | None = None) -> BodySettings:
+        if path is None:
+            from virja.resources import motions_dir
+
+            path = motions_dir() / "drummer_body.toml"
+        if not path.is_file():
+            return cls()
+        d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
+        t, b, a = d["turn"], d["breath"], d["arms"]
+        return cls(
+            gain=float(t["gain"]),
+            max_turn_deg=float(t["max_deg"]),
+            smooth_s=float(t["smooth_s"]),
+            chest_share=float(t["chest_share"]),
+            head_share=float(t["head_share"]),
+            breath_deg=float(b["chest_deg"]),
+            breath_period_s=float(b["period_s"]),
+            beat_deg=float(d["beat"]["spine_deg"]),
+            sway_deg=float(d["beat"]["sway_deg"]),
+            reference_spb=float(d["beat"]["reference_spb"]),
+            engage_s=float(a["engage_s"]),
+            release_s=float(a["release_s"]),
+        )
+
+
+class DrummerBody:
+    """The strokes of the two hands, and the body layer computed from them."""
+
+    def __init__(
+        self,
+        root: np.ndarray,
+        geometry: Geometry = GEOMETRY,
+        settings: BodySettings | None = None,
+    ) -> None:
+        self.settings = settings or BodySettings.load()
+        # azimuth (rad, about +y, 0 = facing +z) of each piece seen from the chest
+        chest = np.asarray(root, dtype=np.float64) + _SK.offsets[_SPINE] + _SK.offsets[_CHEST]
+        self.azimuth: dict[str, float] = {}
+        for name, piece in geometry.kit.pieces.items():
+            d = np.asarray(piece.centre) - chest
+            self.azimuth[name] = float(np.arctan2(d[0], d[2]))
+        self._times: dict[str, list[float]] = {h: [] for h in HANDS}
+        self._az: dict[str, list[float]] = {h: [] for h in HANDS}
+
+    def add_stroke(self, limb: str, impact: float, piece: str | None) -> None:
+        """Record a hand's stroke (feet and unknown pieces are ignored)."""
+        if limb not in self._times or piece not in self.azimuth:
+            return
+        i = bisect.bisect_right(self._times[limb], impact)
+        self._times[limb].insert(i, impact)
+        self._az[limb].insert(i, self.azimuth[piece])
+
+    def forget_before(self, time_s: float) -> None:
+        horizon = time_s - 10.0
+        for h in HANDS:
+            k = max(bisect.bisect_left(self._times[h], horizon) - 1, 0)
+            del self._times[h][:k]
+            del self._az[h][:k]
+
+    # ------------------------------------------------------------------ curves
+
+    def _hand_azimuth(self, hand: str, t: np.ndarray) -> np.ndarray:
+        """Azimuth of the hand's piece: the last stroke's, or the next one's before any."""
+        ts = np.asarray(self._times[hand])
+        az = np.asarray(self._az[hand])
+        if ts.size == 0:
+            return np.full(t.shape, np.nan)
+        i = np.clip(np.searchsorted(ts, t, side="right") - 1, 0, ts.size - 1)
+        return np.asarray(az[i])
+
+    def _target(self, t: np.ndarray) -> np.ndarray:
+        s = self.settings
+        both = np.stack([self._hand_azimuth(h, t) for h in HANDS])
+        n = np.sum(~np.isnan(both), axis=0)
+        mean = np.where(n > 0, np.nansum(both, axis=0) / np.maximum(n, 1), 0.0)
+        lim = np.radians(s.max_turn_deg)
+        return np.asarray(np.clip(s.gain * mean, -lim, lim))
+
+    def turn(self, t: np.ndarray) -> np.ndarray:
+        """The torso's yaw (rad) at times ``t``: the target's exact moving average over
+        ``smooth_s`` (the target is a step function, so the turn is piecewise linear)."""
+        t = np.asarray(t, dtype=np.float64)
+        half = self.settings.smooth_s / 2
+        steps = np.unique(np.concatenate([np.asarray(self._times[h]) for h in HANDS]))
+        if steps.size == 0 or t.size == 0:
+            return np.asarray(self._target(t))
+        lo = min(float(t.min()) - half, float(steps[0])) - 1.0
+        hi = max(float(t.max()) + half, float(steps[-1])) + 1.0
+        knots = np.concatenate([[lo], steps, [hi]])
+        values = self._target((knots[:-1] + knots[1:]) / 2)  # the target on each interval
+        integral = np.concatenate([[0.0], np.cumsum(values * np.diff(knots))])
+        area = np.interp(t + half, knots, integral) - np.interp(t - half, knots, integral)
+        return np.asarray(area / (2 * half))
+
+    def engagement(self, hand: str, t: np.ndarray) -> np.ndarray:
+        """1 while ``hand`` plays (within ``engage_s`` of an impact), fading to 0 at rest."""
+        s = self.settings
+        ts = np.asarray(self._times[hand])
+        if ts.size == 0:
+            return np.zeros(t.shape)
+        i = np.searchsorted(ts, t)
+        prev = ts[np.clip(i - 1, 0, ts.size - 1)]
+        nxt = ts[np.clip(i, 0, ts.size - 1)]
+        gap = np.minimum(np.abs(t - prev), np.abs(nxt - t))
+        return np.asarray(np.clip((s.engage_s + s.release_s - gap) / s.release_s, 0.0, 1.0))
+
+    def _beat_phase(
+        self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Phase in the current beat (0..1), seconds per beat, and +-1 alternating by beat."""
+        s = self.settings
+        i = np.searchsorted(beat_times, t, side="right") - 1
+        if beat_times.size:
+            k = np.maximum(i, 0)
+            spb = beat_spb[k]
+            start = beat_times[k]
+            phase = np.where(i >= 0, np.minimum((t - start) / spb, 1.0), 0.0)
+        else:
+            spb = np.full(t.shape, s.reference_spb)
+            start = np.floor(t / spb) * spb
+            phase = np.mod(t / spb, 1.0)
+        # alternate by the beat's place on its tempo's grid; the sin^2 shapes below are
+        # 0 at every beat, so a tempo change that repeats a sign never makes a jump
+        sign = np.where(np.mod(np.round(start / spb), 2) == 0, 1.0, -1.0)
+        return phase, spb, sign
+
+    def _lean(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
+        """Forward lean (rad) on each beat."""
+        s = self.settings
+        phase, spb, _sign = self._beat_phase(t, beat_times, beat_spb)
+        amp = np.radians(s.beat_deg) * np.clip(spb / s.reference_spb, 0.3, 1.5)
+        return np.asarray(amp * np.sin(np.pi * phase) ** 2)
+
+    def _sway(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
+        """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
+        s = self.settings
+        phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
+        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, 0.5, 1.5)
+        return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
+
+    # ------------------------------------------------------------------ apply
+
+    def apply(
+        self,
+        times: np.ndarray,
+        local: np.ndarray,
+        root: np.ndarray,
+        beat_times: np.ndarray,
+        beat_spb: np.ndarray,
+    ) -> np.ndarray:
+        """The drummer's local rotations (m, n, 4) at ``times`` (m,) with the body layer on."""
+        s = self.settings
+        t = np.asarray(times, dtype=np.float64)
+        out = np.array(local, dtype=np.float64, copy=True)
+        if s.is_still:
+            return out
+        # before his first stroke the drummer sits still; the body wakes over the second before it
+        firsts = [h[0] for h in self._times.values() if h]
+        if not firsts:
+            return out
+        awake = np.clip(t - (min(firsts) - s.engage_s), 0.0, s.engage_s) / s.engage_s
+        yaw = awake * (self.turn(t) + self._sway(t, beat_times, beat_spb))
+        breath = awake * np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
+        lean = awake * self._lean(t, beat_times, beat_spb)
+        hips = out[:, _HIPS]
+        spine_turn = quat.from_axis_angle(_UP, yaw * (1.0 - s.chest_share))
+        chest_turn = quat.from_axis_angle(_UP, yaw * s.chest_share)
+        # world-vertical turns expressed in the parent's frame (the hips do not move)
+        spine_w = quat.multiply(quat.from_axis_angle(_SIDE, lean), spine_turn)
+        out[:, _SPINE] = quat.multiply(
+            quat.multiply(quat.conjugate(hips), quat.multiply(spine_w, hips)), out[:, _SPINE]
+        )
+        chest_local = quat.multiply(chest_turn, quat.from_axis_angle(_SIDE, breath))
+        out[:, _CHEST] = quat.multiply(chest_local, out[:, _CHEST])
+        out[:, _NECK] = quat.multiply(quat.from_axis_angle(_UP, yaw * s.head_share), out[:, _NECK])
+        p0, r0 = _SK.fk(local, root)
+        p1, r1 = _SK.fk(out, root)
+        for hand in HANDS:
+            c = self.engagement(hand, t)
+            if not np.any(c > 0):
+                continue
+            sh, arm, fore, wrist = _ARMS[hand]
+            solved = _resolve_arm(p0, r0, p1[:, arm], r1[:, sh], arm, fore, wrist)
+            for j, q in zip((arm, fore, wrist), solved, strict=True):
+                out[:, j] = quat.slerp(out[:, j], q, c)
+        return out
+
+
+def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frames (..., 3, 3), columns [d, h orthogonalised, d x h]."""
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
+    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
+    return np.stack([d, h, np.cross(d, h)], axis=-1)
+
+
+def _resolve_arm(
+    p0: np.ndarray,
+    r0: np.ndarray,
+    shoulder: np.ndarray,
+    shoulder_rot: np.ndarray,
+    arm: int,
+    fore: int,
+    wrist: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Local rotations of (arm, forearm, hand) putting the wrist and hand as in the
+    authored pose (``p0``, ``r0``) from the moved ``shoulder`` (m, 3)."""
+    l1 = float(np.linalg.norm(_SK.offsets[fore]))
+    l2 = float(np.linalg.norm(_SK.offsets[wrist]))
+    s0, e0, w = p0[:, arm], p0[:, fore], p0[:, wrist]
+    to = w - shoulder
+    dist = np.linalg.norm(to, axis=-1)
+    d = np.clip(dist, abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
+    u = to / dist[:, None]
+    v = (e0 + shoulder - s0) - shoulder  # the authored elbow, carried with the shoulder
+    v = v - np.sum(v * u, axis=-1, keepdims=True) * u
+    v = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+    cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
+    a = np.arccos(cos_a)[:, None]
+    e1 = shoulder + l1 * (np.cos(a) * u + np.sin(a) * v)
+    w1 = shoulder + d[:, None] * u
+    up_old, lo_old = e0 - s0, w - e0
+    up_new, lo_new = e1 - shoulder, w1 - e1
+    m_up = _frames(up_new, lo_new) @ np.swapaxes(_frames(up_old, lo_old), -1, -2)
+    m_lo = _frames(lo_new, -up_new) @ np.swapaxes(_frames(lo_old, -up_old), -1, -2)
+    world_up = quat.multiply(quat.from_matrix(m_up), r0[:, arm])
+    world_lo = quat.multiply(quat.from_matrix(m_lo), r0[:, fore])
+    return (
+        quat.multiply(quat.conjugate(shoulder_rot), world_up),
+        quat.multiply(quat.conjugate(world_up), world_lo),
+        quat.multiply(quat.conjugate(world_lo), r0[:, wrist]),
+    )
+
+
+__all__ = ["BodySettings", "DrummerBody", "HANDS"]

@@ -39,6 +39,7 @@ from virja.dance.audio import FloatArray
 from virja.errors import VirjaError
 from virja.motion import quat
 from virja.motion.bvh import Bvh, BvhJoint, world_pose
+from virja.motion.export import skeleton_joints
 from virja.motion.skeleton import SKELETON
 
 
@@ -161,18 +162,7 @@ def _end_position(bvh: Bvh, pos: FloatArray, rot: FloatArray, j: int) -> FloatAr
 
 def figure_joints() -> list[BvhJoint]:
     """BVH joints of the figure's skeleton (root with position channels, metres)."""
-    out = []
-    for i, name in enumerate(SKELETON.names):
-        ch: tuple[str, ...] = ("Zrotation", "Xrotation", "Yrotation")
-        if i == 0:
-            ch = ("Xposition", "Yposition", "Zposition", *ch)
-        off = SKELETON.offsets[i]
-        out.append(
-            BvhJoint(
-                name, int(SKELETON.parents[i]), (float(off[0]), float(off[1]), float(off[2])), ch
-            )
-        )
-    return out
+    return skeleton_joints()
 
 
 def is_figure_skeleton(bvh: Bvh) -> bool:

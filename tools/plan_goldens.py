@@ -19,6 +19,7 @@ import contextlib
 import hashlib
 import io
 import sys
+import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -27,7 +28,11 @@ FRAME_TIMES = (0.5, 2.0, 5.25, 9.0, 14.6, 21.0)
 
 
 def _key(path: Path) -> str:
-    digest = hashlib.sha1(str(path.resolve()).encode()).hexdigest()[:10]
+    """The golden's name: the input's stem and a hash of its path (relative to the
+    checkout for files inside it, so every worktree finds the demos' goldens)."""
+    full = path.resolve()
+    name = str(full.relative_to(ROOT)) if full.is_relative_to(ROOT) else str(full)
+    digest = hashlib.sha1(name.encode()).hexdigest()[:10]
     return f"{path.stem}_{digest}"
 
 
@@ -50,10 +55,11 @@ def _frames(folder: Path, mode: str) -> list[str]:
     from virja.cli.main import main
 
     problems = []
+    scratch = Path(tempfile.mkdtemp(prefix="plan-goldens-"))
     demo = str(ROOT / "virja" / "demo" / "blues.mid")
     for t in FRAME_TIMES:
         target = folder / f"frame_{t:06.2f}.png"
-        out = target if mode == "record" else folder / f"new_frame_{t:06.2f}.png"
+        out = target if mode == "record" else scratch / f"new_frame_{t:06.2f}.png"
         rc = main(["render", demo, "--at", str(t), "--size", "640x360", "--out", str(out)])
         if rc != 0:
             problems.append(f"render --at {t}: exit {rc}")

@@ -24,6 +24,7 @@ import msgspec
 from virja import tomlconf
 from virja.config import load_config, section
 from virja.errors import ConfigError
+from virja.kit_file import KitFile
 from virja.resources import motions_dir
 from virja.tomlconf import Schema, convert, schema_of
 
@@ -259,21 +260,6 @@ class BassFile(Schema):
     double_stop_span_frets: int
     tunings: dict[str, TuningTable]
     fingering: FingeringTable = msgspec.field(default_factory=FingeringTable)  # type: ignore[valid-type]
-
-
-class KitNoteTable(Schema):
-    piece: str
-    limb: str | None = None
-    priority: int | None = None
-    articulation: str | None = None
-    name: str = ""
-
-
-class KitFile(Schema):
-    """motions/drum_kit.toml (a user's kit map has the same form)"""
-
-    priority: dict[str, int] = {}
-    notes: dict[str, KitNoteTable] = {}
 
 
 class CostsFile(Schema):

@@ -45,7 +45,7 @@ def load_config(path: str | Path | None) -> dict[str, Any]:
         return {}
     doc = tomlconf.read(path, noun="config file", error=_input_error)
     try:
-        tomlconf.convert(doc, ConfigFile, str(path))
+        tomlconf.convert(doc, ConfigFile, str(path), finite=False)
     except tomlconf.SchemaError as exc:
         if exc.key in doc and exc.key not in KNOWN_TABLES:
             raise ConfigError(

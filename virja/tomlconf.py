@@ -90,15 +90,17 @@ def load(
     return convert(read(path, noun=noun, error=error), schema, str(path))
 
 
-def convert(data: Mapping[str, Any], schema: type[T], where: str) -> T:
+def convert(data: Mapping[str, Any], schema: type[T], where: str, *, finite: bool = True) -> T:
     """``data`` (a TOML table) as ``schema``; ``where`` names the table in errors.
-    Raises :class:`SchemaError`."""
+    Raises :class:`SchemaError`.  ``finite=False`` leaves the check of numbers to the
+    schemas of the tables inside (the config document's layers)."""
     try:
         out = msgspec.convert(data, schema, strict=True, str_keys=True)
     except msgspec.ValidationError as exc:
         key, reason = _reason(data, schema, str(exc))
         raise SchemaError(where, key, reason) from None
-    _check_finite(data, (), where)
+    if finite:
+        _check_finite(data, (), where)
     return out
 
 
@@ -229,8 +231,9 @@ def _reason(data: Mapping[str, Any], schema: type[Any], text: str) -> tuple[str,
         known = _fields_at(schema, path)
         return key, f"{key}: unknown key" + (f"; known: {', '.join(known)}" if known else "")
     if u := _MISSING.match(msg):
-        key = _key_path((*path, u.group("key")))
-        return key, f"missing {key}"
+        full = (*path, u.group("key"))
+        noun = _noun_at(schema, full)
+        return _key_path(full), f"missing {_key_path(full)}" + (f" ({noun})" if noun else "")
     if e := _EXPECTED.match(msg):
         nouns = [_NOUNS.get(t, t) for t in e.group("types").split(" | ") if t != "null"]
         try:
@@ -246,8 +249,8 @@ def _reason(data: Mapping[str, Any], schema: type[Any], text: str) -> tuple[str,
     return here, (f"{here}: {msg}" if here else msg)
 
 
-def _fields_at(schema: type[Any], path: tuple[Segment, ...]) -> list[str]:
-    """The keys the schema allows in the table at ``path`` (for an unknown key's error)."""
+def _type_at(schema: type[Any], path: tuple[Segment, ...]) -> msgspec.inspect.Type:
+    """The schema's type of the value at ``path`` (AnyType where it cannot tell)."""
     t: msgspec.inspect.Type = msgspec.inspect.type_info(schema)
     for seg in path:
         t = _inner(t)
@@ -258,11 +261,33 @@ def _fields_at(schema: type[Any], path: tuple[Segment, ...]) -> list[str]:
         elif isinstance(t, msgspec.inspect.ListType | msgspec.inspect.VarTupleType):
             t = t.item_type
         else:
-            return []
-    t = _inner(t)
+            return msgspec.inspect.AnyType()
+    return _inner(t)
+
+
+def _fields_at(schema: type[Any], path: tuple[Segment, ...]) -> list[str]:
+    """The keys the schema allows in the table at ``path`` (for an unknown key's error)."""
+    t = _type_at(schema, path)
     if isinstance(t, msgspec.inspect.StructType):
         return sorted(f.encode_name for f in t.fields)
     return []
+
+
+_TYPE_NOUNS: tuple[tuple[type[msgspec.inspect.Type], str], ...] = (
+    (msgspec.inspect.IntType, "an integer"),
+    (msgspec.inspect.FloatType, "a number"),
+    (msgspec.inspect.StrType, "a string"),
+    (msgspec.inspect.BoolType, "true or false"),
+    (msgspec.inspect.StructType, "a table"),
+    (msgspec.inspect.DictType, "a table"),
+    (msgspec.inspect.ListType, "a list"),
+    (msgspec.inspect.TupleType, "a list"),
+)
+
+
+def _noun_at(schema: type[Any], path: tuple[Segment, ...]) -> str:
+    t = _type_at(schema, path)
+    return next((noun for cls, noun in _TYPE_NOUNS if isinstance(t, cls)), "")
 
 
 def _inner(t: msgspec.inspect.Type) -> msgspec.inspect.Type:

@@ -96,9 +96,12 @@ class JamOptions:
         return self.delay_ms / 1000.0
 
     @classmethod
-    def merge(cls, table: Mapping[str, Any], overrides: Mapping[str, Any]) -> JamOptions:
-        """The ``[jam]`` table with the flags given (None: not given) on top."""
-        tomlconf.convert(table, JamTable, "[jam]")  # unknown keys, types: the file's own
+    def merge(
+        cls, table: Mapping[str, Any], overrides: Mapping[str, Any], *, where: str = "[jam]"
+    ) -> JamOptions:
+        """The ``[jam]`` table (``where`` names it in errors) with the flags given (None:
+        not given) on top."""
+        tomlconf.convert(table, JamTable, where)  # unknown keys, types: the file's own
         merged = {**table, **{k: v for k, v in overrides.items() if k in _KEYS and v is not None}}
         given = tomlconf.fields(tomlconf.convert(merged, JamTable, "[jam]"))
         values: dict[str, Any] = {k: v for k, v in given.items() if v is not None}

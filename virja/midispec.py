@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from virja.events import ControlChange, Event, NoteOff, NoteOn, ProgramChange
@@ -111,15 +112,25 @@ def encode(event: Event) -> bytes | None:
     return bytes((spec.status | event.channel, *values))  # type: ignore[union-attr]
 
 
+# mido type name -> (event class, getter of (channel, *fields)): read per message of a
+# file, so built once from SPECS
+_FROM_MIDO: dict[str, tuple[type[ChannelEvent], attrgetter[Any]]] = {
+    s.name: (s.event, attrgetter("channel", *s.fields)) for s in SPECS if s.event is not None
+}
+
+
 def from_mido(
     msg: mido.Message, *, time_s: float, sender: int = 0, track: int | None = None
 ) -> ChannelEvent | None:
     """The event of a mido channel message (None for any other type)."""
-    spec = BY_NAME.get(msg.type)
-    if spec is None or spec.event is None:
+    entry = _FROM_MIDO.get(msg.type)
+    if entry is None:
         return None
-    values = [getattr(msg, f) for f in spec.fields]
-    return _event(spec, msg.channel, values, time_s, sender, track)
+    cls, get = entry
+    values = get(msg)
+    if cls is NoteOn and values[2] == 0:
+        cls = NoteOff
+    return cls(time_s, *values, sender=sender, track=track)  # type: ignore[misc]
 
 
 def to_mido(event: Event) -> mido.Message | None:

@@ -15,38 +15,44 @@ own table, so a layer's options live beside the code that uses them.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Any
 
+from virja import tomlconf
 from virja.errors import ConfigError, InputFileError
+from virja.tomlconf import Schema
 
-KNOWN_TABLES = frozenset({"routing", "plan", "jam"})
+
+class ConfigFile(Schema):
+    """The document: each layer's table, converted by that layer to its own schema
+    (``RoutingTable``, ``PlanTable``, ``JamTable``)."""
+
+    routing: dict[str, Any] = {}
+    plan: dict[str, Any] = {}
+    jam: dict[str, Any] = {}
+
+
+KNOWN_TABLES = frozenset(ConfigFile.__struct_fields__)
+
+
+def _input_error(where: str, reason: str) -> Exception:
+    return InputFileError(where, reason)
 
 
 def load_config(path: str | Path | None) -> dict[str, Any]:
     """The parsed TOML document at ``path`` ({} for None); unknown tables are an error."""
     if path is None:
         return {}
-    p = Path(path)
+    doc = tomlconf.read(path, noun="config file", error=_input_error)
     try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputFileError(p, f"cannot read config file: {exc.strerror or exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise InputFileError(p, f"config file is not UTF-8 text: {exc.reason}") from exc
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputFileError(p, f"invalid TOML: {exc}") from exc
-    unknown = sorted(set(doc) - KNOWN_TABLES)
-    if unknown:
-        raise ConfigError(
-            f"{p}: unknown table(s) {', '.join(unknown)}; known: {', '.join(sorted(KNOWN_TABLES))}"
-        )
-    for name, table in doc.items():
-        if not isinstance(table, dict):
-            raise ConfigError(f"{p}: [{name}] must be a table")
+        tomlconf.convert(doc, ConfigFile, str(path), finite=False)
+    except tomlconf.SchemaError as exc:
+        if exc.key in doc and exc.key not in KNOWN_TABLES:
+            raise ConfigError(
+                f"{path}: unknown table(s) {', '.join(sorted(set(doc) - KNOWN_TABLES))}; "
+                f"known: {', '.join(sorted(KNOWN_TABLES))}"
+            ) from None
+        raise
     return doc
 
 

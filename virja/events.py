@@ -130,20 +130,6 @@ class Chord:
 Event = NoteOn | NoteOff | ControlChange | ProgramChange | Beat | Chord
 
 
-def midi_bytes(event: Event) -> bytes | None:
-    """The MIDI 1.0 message of a channel event (status byte included); None for Beat
-    and Chord.  Used by every sender: RMCP (``virja send``, jam --send) and MIDI thru."""
-    if isinstance(event, NoteOn):
-        return bytes((0x90 | event.channel, event.note, event.velocity))
-    if isinstance(event, NoteOff):
-        return bytes((0x80 | event.channel, event.note, event.velocity))
-    if isinstance(event, ControlChange):
-        return bytes((0xB0 | event.channel, event.control, event.value))
-    if isinstance(event, ProgramChange):
-        return bytes((0xC0 | event.channel, event.program))
-    return None
-
-
 def sort_events(events: list[Event]) -> list[Event]:
     """Events ordered by time; simultaneous events keep their given order."""
     return sorted(events, key=lambda e: e.time_s)

@@ -28,9 +28,10 @@ from pathlib import Path
 import mido
 from mido.midifiles.meta import KeySignatureError
 
+from virja import midispec
 from virja.chords import parse_chord_symbol
 from virja.errors import InputFileError
-from virja.events import Beat, Chord, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.events import Beat, Chord, Event, NoteOff, NoteOn, ProgramChange
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, TempoMap
 
 log = logging.getLogger(__name__)
@@ -175,17 +176,11 @@ def read_midi(path: str | Path) -> MidiSession:
                         chords.append(chord)
                 continue
             t = clock.to_seconds(tick)
-            ev: NoteOn | NoteOff | ControlChange | ProgramChange | None = None
-            if msg.type == "note_on" and msg.velocity > 0:
-                ev = NoteOn(t, msg.channel, msg.note, msg.velocity, track=ti)
+            ev = midispec.from_mido(msg, time_s=t, track=ti)
+            if isinstance(ev, NoteOn):
                 n_notes += 1
-            elif msg.type == "note_off" or msg.type == "note_on":
-                ev = NoteOff(t, msg.channel, msg.note, msg.velocity, track=ti)
-            elif msg.type == "control_change":
-                ev = ControlChange(t, msg.channel, msg.control, msg.value, track=ti)
-            elif msg.type == "program_change":
-                ev = ProgramChange(t, msg.channel, msg.program, track=ti)
-                programs.add(msg.program)
+            elif isinstance(ev, ProgramChange):
+                programs.add(ev.program)
             if ev is not None:
                 channels.add(ev.channel)
                 events.append((tick, ti, order, ev))

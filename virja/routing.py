@@ -26,8 +26,10 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from virja import tomlconf
 from virja.errors import ConfigError
 from virja.events import Event, NoteOff, NoteOn, Performer, ProgramChange
+from virja.tomlconf import Schema
 
 GM_BASS_PROGRAMS = frozenset(range(32, 40))  # Acoustic Bass .. Synth Bass 2 (0-based)
 DEFAULT_BASS_WORDS = ("bass", "contrabass", "kontrabass", "basse", "bajo", "baixo", "upright")
@@ -40,15 +42,19 @@ Route = Performer | None
 _TARGETS: dict[str, Route] = {"bass": "bass", "drums": "drums", "none": None}
 
 
-# the keys of the [routing] table (docs/virja.example.toml documents each)
-ROUTING_KEYS = (
-    "drum_channels",
-    "bass_programs",
-    "bass_track_words",
-    "channels",
-    "tracks",
-    "names_over_programs",
-)
+class RoutingTable(Schema):
+    """The ``[routing]`` table of the config file (docs/virja.example.toml documents
+    each key); a key left out keeps :class:`RoutingConfig`'s default."""
+
+    drum_channels: list[int] | None = None
+    bass_programs: list[int] | None = None
+    bass_track_words: list[str] | None = None
+    channels: dict[str, str] = {}
+    tracks: dict[str, str] = {}
+    names_over_programs: bool | None = None
+
+
+ROUTING_KEYS = tuple(RoutingTable.__struct_fields__)
 
 
 @dataclass(frozen=True)
@@ -63,34 +69,30 @@ class RoutingConfig:
     @classmethod
     def from_dict(cls, table: Mapping[str, Any], where: str = "[routing]") -> RoutingConfig:
         """From the ``[routing]`` table of the config file; ``where`` names it in errors."""
-        unknown = set(table) - set(ROUTING_KEYS)
-        if unknown:
-            raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
+        t = tomlconf.convert(table, RoutingTable, where)
         base = cls()
-        drum = frozenset(
-            _channel_list(_list_of(table, "drum_channels", sorted(base.drum_channels), where))
-        )
-        progs = _list_of(table, "bass_programs", sorted(base.bass_programs), where)
-        if not all(isinstance(p, int) and not isinstance(p, bool) and 0 <= p <= 127 for p in progs):
-            raise ConfigError(f"{where} bass_programs: integers 0-127 (GM programs, 0-based)")
-        words_raw = _list_of(table, "bass_track_words", list(base.bass_track_words), where)
-        if not all(isinstance(w, str) for w in words_raw):
-            raise ConfigError(f"{where} bass_track_words: a list of strings")
-        words = tuple(w.lower() for w in words_raw)
+        drum = base.drum_channels
+        if t.drum_channels is not None:
+            drum = frozenset(_channel_list(t.drum_channels))
+        progs = base.bass_programs
+        if t.bass_programs is not None:
+            if not all(0 <= p <= 127 for p in t.bass_programs):
+                raise ConfigError(f"{where} bass_programs: integers 0-127 (GM programs, 0-based)")
+            progs = frozenset(t.bass_programs)
+        words = base.bass_track_words
+        if t.bass_track_words is not None:
+            words = tuple(w.lower() for w in t.bass_track_words)
         chans: dict[int, Route] = {}
-        for k, v in _table_of(table, "channels", where).items():
-            if not str(k).isascii() or not str(k).isdigit():
+        for k, v in t.channels.items():
+            if not k.isascii() or not k.isdigit():
                 raise ConfigError(f"{where}.channels: key {k!r} must be a channel number 1-16")
             (ch,) = _channel_list([int(k)])
             chans[ch] = _target(v, f"{where}.channels {k}")
-        tracks = {
-            str(k).lower(): _target(v, f"{where}.tracks {k!r}")
-            for k, v in _table_of(table, "tracks", where).items()
-        }
-        names_first = table.get("names_over_programs", base.names_over_programs)
-        if not isinstance(names_first, bool):
-            raise ConfigError(f"{where} names_over_programs: true or false, got {names_first!r}")
-        return cls(drum, frozenset(progs), words, chans, tracks, names_first)
+        tracks = {k.lower(): _target(v, f"{where}.tracks {k!r}") for k, v in t.tracks.items()}
+        names_first = base.names_over_programs
+        if t.names_over_programs is not None:
+            names_first = t.names_over_programs
+        return cls(drum, progs, words, chans, tracks, names_first)
 
     def with_overrides(
         self,
@@ -117,20 +119,6 @@ class RoutingConfig:
             tracks,
             self.names_over_programs,
         )
-
-
-def _list_of(table: Mapping[str, Any], key: str, default: list[Any], where: str) -> list[Any]:
-    value = table.get(key, default)
-    if not isinstance(value, list):
-        raise ConfigError(f"{where} {key}: must be a list, got {type(value).__name__} {value!r}")
-    return value
-
-
-def _table_of(table: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
-    value = table.get(key, {})
-    if not isinstance(value, Mapping):
-        raise ConfigError(f"{where} {key}: must be a table, got {type(value).__name__} {value!r}")
-    return value
 
 
 def _channel_list(values: Iterable[Any]) -> list[int]:

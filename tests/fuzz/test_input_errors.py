@@ -49,7 +49,10 @@ def test_animation_toml_faults_are_config_errors(tmp_path: Path) -> None:
     cases = {
         "not UTF-8": b"\xff\xfe[idle]\n",
         "invalid TOML": "[idle\n",
-        "missing key": good.replace("sway_period_s", "sway_period_x"),
+        "idle.sway_period_x: unknown key": good.replace("sway_period_s", "sway_period_x"),
+        "missing idle.sway_period_s": "\n".join(
+            ln for ln in good.splitlines() if not ln.strip().startswith("sway_period_s")
+        ),
         "sway_period_s must be": good.replace(
             f"sway_period_s = {_value(good, 'sway_period_s')}", "sway_period_s = 0"
         ),

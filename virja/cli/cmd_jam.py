@@ -118,7 +118,8 @@ def _options(args: argparse.Namespace, doc: dict[str, Any]) -> JamOptions:
         "thru": args.thru,
         "send": args.send,
     }
-    return JamOptions.merge(section(doc, "jam"), flags)
+    where = f"{args.config} [jam]" if args.config else "[jam]"
+    return JamOptions.merge(section(doc, "jam"), flags, where=where)
 
 
 def _list_ports(api: str | None) -> int:

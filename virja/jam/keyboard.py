@@ -19,8 +19,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
+from virja import midispec
 from virja.errors import ConfigError
-from virja.events import ControlChange, NoteOff, NoteOn, Performer, ProgramChange, midi_bytes
+from virja.events import ControlChange, NoteOff, NoteOn, Performer, ProgramChange
 
 LiveEvent = NoteOn | NoteOff | ControlChange | ProgramChange
 UpperMode = Literal["ignore", "drums"]
@@ -111,27 +112,12 @@ def decode(data: Sequence[int], *, time_s: float) -> LiveEvent | None:
     aftertouch are not events of the band (the thru output forwards them raw).
     A short or malformed message gives None, never an exception.
     """
-    if not data:
-        return None
-    status = data[0]
-    if not 0x80 <= status <= 0xEF or any(not 0 <= b <= 127 for b in data[1:]):
-        return None
-    kind, channel = status & 0xF0, status & 0x0F
-    if kind in (0x80, 0x90, 0xB0) and len(data) >= 3:
-        a, b = data[1], data[2]
-        if kind == 0x90 and b > 0:
-            return NoteOn(time_s=time_s, channel=channel, note=a, velocity=b)
-        if kind in (0x80, 0x90):
-            return NoteOff(time_s=time_s, channel=channel, note=a, velocity=b)
-        return ControlChange(time_s=time_s, channel=channel, control=a, value=b)
-    if kind == 0xC0 and len(data) >= 2:
-        return ProgramChange(time_s=time_s, channel=channel, program=data[1])
-    return None
+    return midispec.decode(data, time_s=time_s)
 
 
 def encode(event: LiveEvent) -> bytes:
     """The MIDI bytes of an event (the inverse of :func:`decode`)."""
-    data = midi_bytes(event)
+    data = midispec.encode(event)
     assert data is not None  # every LiveEvent is a channel event
     return data
 

@@ -20,13 +20,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from virja import tomlconf
 from virja.errors import ConfigError
 from virja.jam.keyboard import DEFAULT_SPLIT, UPPER_MODES, KeyboardLayout, UpperMode
 from virja.jam.ports import API_NAMES
+from virja.tomlconf import Schema
 
 MAX_DELAY_MS = 2000.0  # more than two seconds is not a jam any more; a typo, most likely
 
-_KEYS = ("api", "port", "split", "upper", "delay_ms", "thru", "send", "fps")
 _KEY_NAME = re.compile(r"^([A-Ga-g])([#b]?)(-?\d)$")
 _PITCH = {"c": 0, "d": 2, "e": 4, "f": 5, "g": 7, "a": 9, "b": 11}
 
@@ -46,6 +47,22 @@ def parse_key(value: object) -> int:
     if not 0 <= key <= 127:
         raise ConfigError(f"split: {value!r} is outside the MIDI keys 0-127")
     return key
+
+
+class JamTable(Schema):
+    """The ``[jam]`` table (the module's docstring shows each key); absent: the default."""
+
+    api: str | None = None
+    port: str | None = None
+    split: int | str | None = None
+    upper: str | None = None
+    delay_ms: float | None = None
+    thru: str | None = None
+    send: str | None = None
+    fps: float | None = None
+
+
+_KEYS = tuple(JamTable.__struct_fields__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,21 +96,15 @@ class JamOptions:
         return self.delay_ms / 1000.0
 
     @classmethod
-    def merge(cls, table: Mapping[str, Any], overrides: Mapping[str, Any]) -> JamOptions:
-        """The ``[jam]`` table with the flags given (None: not given) on top."""
-        unknown = sorted(set(table) - set(_KEYS))
-        if unknown:
-            raise ConfigError(f"[jam]: unknown key(s) {', '.join(unknown)}; known: {_KEYS}")
-        values: dict[str, Any] = dict(table)
-        values.update({k: v for k, v in overrides.items() if k in _KEYS and v is not None})
+    def merge(
+        cls, table: Mapping[str, Any], overrides: Mapping[str, Any], *, where: str = "[jam]"
+    ) -> JamOptions:
+        """The ``[jam]`` table (``where`` names it in errors) with the flags given (None:
+        not given) on top."""
+        tomlconf.convert(table, JamTable, where)  # unknown keys, types: the file's own
+        merged = {**table, **{k: v for k, v in overrides.items() if k in _KEYS and v is not None}}
+        given = tomlconf.fields(tomlconf.convert(merged, JamTable, "[jam]"))
+        values: dict[str, Any] = {k: v for k, v in given.items() if v is not None}
         if "split" in values:
             values["split"] = parse_key(values["split"])
-        for key, typ in (("delay_ms", (int, float)), ("fps", (int, float))):
-            if key in values and (
-                not isinstance(values[key], typ) or isinstance(values[key], bool)
-            ):
-                raise ConfigError(f"[jam] {key} must be a number, got {values[key]!r}")
-        for key in ("api", "port", "upper", "thru", "send"):
-            if key in values and not isinstance(values[key], str):
-                raise ConfigError(f"[jam] {key} must be a string, got {values[key]!r}")
         return cls(**values)

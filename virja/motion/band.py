@@ -14,7 +14,6 @@ from __future__ import annotations
 import bisect
 import logging
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,7 +21,6 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from virja.errors import ConfigError
 from virja.events import Beat
 from virja.geometry import (
     ALL_BASS_STRINGS,
@@ -122,61 +120,17 @@ class AnimationSettings:
 
     @classmethod
     def load(cls, path: Path | None = None) -> AnimationSettings:
+        """motions/animation.toml (or ``path``); the defaults when the file is absent.
+        Its schema: :class:`virja.motion.settings_files.AnimationFile`."""
+        from virja.motion.settings_files import animation_settings
+
         if path is None:
             from virja.resources import motions_dir
 
             path = motions_dir() / "animation.toml"
         if not path.is_file():
             return cls()
-        where = str(path)
-        try:
-            d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
-        except UnicodeDecodeError:
-            raise ConfigError(f"{where}: not UTF-8 text") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"{where}: invalid TOML: {exc}") from None
-        except OSError as exc:
-            raise ConfigError(f"{where}: cannot read: {exc.strerror or exc}") from None
-        try:
-            k = d.get("kit", {})
-            settings = cls(
-                vel_floor=float(d["velocity"]["floor"]),
-                vel_ceiling=float(d["velocity"]["ceiling"]),
-                reference_spb=float(d["tempo"]["reference_spb"]),
-                max_rate=float(d["tempo"]["max_rate"]),
-                nod_rad=float(d["idle"]["nod_rad"]),
-                sway_rad=float(d["idle"]["sway_rad"]),
-                sway_period_s=float(d["idle"]["sway_period_s"]),
-                head_decay_s=float(k["head_decay_s"]),
-                swing=tuple(_swing(p, k[f"{p}_swing"]) for p in ("ride", "crash", "hihat")),
-                hihat_travel_m=float(k["hihat_travel_m"]),
-                hihat_lead_s=float(k.get("hihat_lead_s", cls.hihat_lead_s)),
-                hihat_hold_open_s=float(k.get("hihat_hold_open_s", cls.hihat_hold_open_s)),
-                string_amp_m=float(d["strings"]["amplitude_m"]),
-                string_decay_s=float(d["strings"]["decay_s"]),
-                bassist=BassistSettings.from_table(d.get("bassist", {})),
-            )
-        except KeyError as exc:
-            raise ConfigError(f"{where}: missing key {exc.args[0]!r}") from None
-        except (TypeError, ValueError, IndexError, AttributeError) as exc:
-            raise ConfigError(f"{where}: a value has the wrong type or shape: {exc}") from None
-        positive = {
-            "tempo.reference_spb": settings.reference_spb,
-            "tempo.max_rate": settings.max_rate,
-            "idle.sway_period_s": settings.sway_period_s,
-            "kit.head_decay_s": settings.head_decay_s,
-            "strings.decay_s": settings.string_decay_s,
-            "kit.hihat_lead_s": settings.hihat_lead_s,
-            "kit.hihat_hold_open_s": settings.hihat_hold_open_s,
-        }
-        for name, value in positive.items():
-            if not (math.isfinite(value) and value > 0):
-                raise ConfigError(f"{where}: {name} must be a finite number > 0, got {value}")
-        return settings
-
-
-def _swing(piece: str, v: list[float]) -> tuple[str, float, float, float]:
-    return (piece, float(v[0]), float(v[1]), float(v[2]))
+        return animation_settings(path)
 
 
 @dataclass(frozen=True)

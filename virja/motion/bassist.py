@@ -28,7 +28,6 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -65,14 +64,6 @@ class BassistSettings:
     vibrato_hz: float = 5.0
     vibrato_after_s: float = 0.25  # it starts this long after the impact
     long_note_s: float = 0.45  # notes at least this long get vibrato
-
-    @classmethod
-    def from_table(cls, table: dict[str, Any]) -> BassistSettings:
-        known = set(cls.__dataclass_fields__)
-        unknown = sorted(set(table) - known)
-        if unknown:
-            raise ValueError(f"animation.toml [bassist]: unknown key(s) {', '.join(unknown)}")
-        return cls(**{k: type(getattr(cls(), k))(v) for k, v in table.items()})
 
 
 @dataclass

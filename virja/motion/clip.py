@@ -20,7 +20,6 @@ joint names can replace any clip.  Errors name the file (and the line).
 from __future__ import annotations
 
 import logging
-import tomllib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,10 +27,12 @@ from typing import Any
 
 import numpy as np
 
+from virja import tomlconf
 from virja.errors import InputFileError, VirjaError
 from virja.geometry import ALL_BASS_STRINGS, PIECES
 from virja.motion.bvh import Bvh, read_bvh
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON, Skeleton
+from virja.tomlconf import Schema
 
 log = logging.getLogger(__name__)
 
@@ -149,76 +150,70 @@ def _fail(path: Path, text: str, key: str | None, reason: str) -> ClipError:
     return ClipError(path, f"{where}{reason}")
 
 
+class SidecarFile(Schema):
+    """A clip's ``<name>.toml`` (the module's docstring explains each key)."""
+
+    performer: str
+    kind: str
+    impact_s: float
+    joints: list[str]
+    limb: str | None = None
+    piece: str | None = None
+    string: str | None = None
+    fret: int | None = None
+    velocity: int = 96
+
+
+def _clip_error(where: str, reason: str) -> Exception:
+    return ClipError(where, reason)
+
+
 def read_sidecar(path: Path) -> dict[str, Any]:
     """Parse and validate a clip sidecar; errors name the file and line."""
+    text = tomlconf.read_text(path, noun="clip sidecar", error=_clip_error)
+    data = tomlconf.parse(text, str(path), error=_clip_error)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ClipError(path, f"cannot read clip sidecar: {exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise ClipError(
-            path, f"clip sidecar is not UTF-8 text: {exc.reason} at byte {exc.start}"
-        ) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ClipError(path, str(exc)) from None
-
-    def need(key: str, typ: type | tuple[type, ...]) -> Any:
-        if key not in data:
-            raise _fail(path, text, None, f"missing key {key!r}")
-        v = data[key]
-        if not isinstance(v, typ) or isinstance(v, bool):
-            raise _fail(path, text, key, f"{key} has the wrong type ({type(v).__name__})")
-        return v
-
-    performer = need("performer", str)
-    if performer not in PERFORMERS:
+        side = tomlconf.convert(data, SidecarFile, str(path))
+    except tomlconf.SchemaError as exc:
+        key = exc.key.split(".")[0].split("[")[0]
+        raise _fail(path, text, key if key in data else None, exc.reason) from None
+    if side.performer not in PERFORMERS:
         raise _fail(
-            path, text, "performer", f"performer must be one of {PERFORMERS}, got {performer!r}"
+            path,
+            text,
+            "performer",
+            f"performer must be one of {PERFORMERS}, got {side.performer!r}",
         )
-    kind = need("kind", str)
-    if kind not in KINDS:
-        raise _fail(path, text, "kind", f"kind must be one of {KINDS}, got {kind!r}")
-    limb = data.get("limb")
-    if kind != "idle":
-        limb = need("limb", str)
-        if limb not in LIMB_JOINTS:
+    if side.kind not in KINDS:
+        raise _fail(path, text, "kind", f"kind must be one of {KINDS}, got {side.kind!r}")
+    if side.kind != "idle":
+        if side.limb is None:
+            raise _fail(path, text, None, "missing key 'limb'")
+        if side.limb not in LIMB_JOINTS:
             raise _fail(
-                path, text, "limb", f"limb must be one of {tuple(LIMB_JOINTS)}, got {limb!r}"
+                path, text, "limb", f"limb must be one of {tuple(LIMB_JOINTS)}, got {side.limb!r}"
             )
-    impact = float(need("impact_s", (int, float)))
-    if not 0 <= impact < float("inf"):
-        raise _fail(path, text, "impact_s", f"impact_s must be finite and >= 0, got {impact}")
-    joints = need("joints", list)
-    if not joints or not all(isinstance(j, str) for j in joints):
-        raise _fail(path, text, "joints", "joints must be a non-empty list of joint names")
-    piece = data.get("piece")
-    if piece is not None and piece not in PIECES:
-        raise _fail(path, text, "piece", f"unknown piece {piece!r}; expected one of {PIECES}")
-    string = data.get("string")
-    if string is not None and string not in ALL_BASS_STRINGS:
+    if not 0 <= side.impact_s < float("inf"):
         raise _fail(
-            path, text, "string", f"unknown string {string!r}; expected one of {ALL_BASS_STRINGS}"
+            path, text, "impact_s", f"impact_s must be finite and >= 0, got {side.impact_s}"
         )
-    fret = data.get("fret")
-    if fret is not None and (
-        not isinstance(fret, int) or isinstance(fret, bool) or not 0 <= fret <= 24
-    ):
-        raise _fail(path, text, "fret", f"fret must be a whole number 0-24, got {fret!r}")
-    velocity = data.get("velocity", 96)
-    if not isinstance(velocity, int) or isinstance(velocity, bool) or not 1 <= velocity <= 127:
-        raise _fail(path, text, "velocity", f"velocity must be 1-127, got {velocity!r}")
-    out = dict(data)
-    out.update(
-        performer=performer,
-        kind=kind,
-        limb=limb,
-        impact_s=impact,
-        joints=list(joints),
-        velocity=velocity,
-        _text=text,
-    )
+    if not side.joints:
+        raise _fail(path, text, "joints", "joints must be a non-empty list of joint names")
+    if side.piece is not None and side.piece not in PIECES:
+        raise _fail(path, text, "piece", f"unknown piece {side.piece!r}; expected one of {PIECES}")
+    if side.string is not None and side.string not in ALL_BASS_STRINGS:
+        raise _fail(
+            path,
+            text,
+            "string",
+            f"unknown string {side.string!r}; expected one of {ALL_BASS_STRINGS}",
+        )
+    if side.fret is not None and not 0 <= side.fret <= 24:
+        raise _fail(path, text, "fret", f"fret must be a whole number 0-24, got {side.fret!r}")
+    if not 1 <= side.velocity <= 127:
+        raise _fail(path, text, "velocity", f"velocity must be 1-127, got {side.velocity!r}")
+    out: dict[str, Any] = tomlconf.fields(side)
+    out["_text"] = text
     return out
 
 

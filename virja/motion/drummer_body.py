@@ -29,10 +29,8 @@ motions/drummer_body.toml.  Everything is vectorised over times.
 from __future__ import annotations
 
 import bisect
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -88,22 +86,9 @@ class BodySettings:
             path = motions_dir() / "drummer_body.toml"
         if not path.is_file():
             return cls()
-        d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
-        t, b, a = d["turn"], d["breath"], d["arms"]
-        return cls(
-            gain=float(t["gain"]),
-            max_turn_deg=float(t["max_deg"]),
-            smooth_s=float(t["smooth_s"]),
-            chest_share=float(t["chest_share"]),
-            head_share=float(t["head_share"]),
-            breath_deg=float(b["chest_deg"]),
-            breath_period_s=float(b["period_s"]),
-            beat_deg=float(d["beat"]["spine_deg"]),
-            sway_deg=float(d["beat"]["sway_deg"]),
-            reference_spb=float(d["beat"]["reference_spb"]),
-            engage_s=float(a["engage_s"]),
-            release_s=float(a["release_s"]),
-        )
+        from virja.motion.settings_files import body_settings
+
+        return body_settings(path)
 
 
 class DrummerBody:

@@ -16,8 +16,10 @@ the caller falls back to the left toe on the pedal.
 from __future__ import annotations
 
 import bisect
-import tomllib
-from collections.abc import Mapping
+
+from virja import tomlconf
+from virja.errors import ConfigError
+from virja.kit_file import KitFile
 
 OPEN = frozenset({"open", "open_edge"})
 CLOSED = frozenset({"closed", "closed_edge", "pedal"})
@@ -25,23 +27,18 @@ CLOSED = frozenset({"closed", "closed_edge", "pedal"})
 
 def default_articulations() -> dict[int, str | None]:
     """Articulation per note number from the shipped kit map (motions/drum_kit.toml,
-    ``[notes]``), so every animator, in any process, opens the hi-hat by the notes;
-    a user's kit map replaces it through ``BandAnimator.set_articulations``.  The
-    file is validated by virja.plan.config; entries that do not parse are skipped."""
+    ``[notes]``, schema :class:`virja.kit_file.KitFile`), so every animator, in any
+    process, opens the hi-hat by the notes; a user's kit map replaces it through
+    ``BandAnimator.set_articulations``.  The planner reports a kit map that does not
+    fit its schema; here such a file, or a note key that is not a number, gives no
+    articulations."""
     from virja.resources import motions_dir
 
     try:
-        d = tomllib.loads((motions_dir() / "drum_kit.toml").read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        kit = tomlconf.load(motions_dir() / "drum_kit.toml", KitFile)
+    except ConfigError:
         return {}
-    notes = d.get("notes", {})
-    out: dict[int, str | None] = {}
-    if isinstance(notes, Mapping):
-        for key, entry in notes.items():
-            if str(key).isdigit() and isinstance(entry, Mapping):
-                art = entry.get("articulation")
-                out[int(key)] = art if isinstance(art, str) else None
-    return out
+    return {int(key): entry.articulation for key, entry in kit.notes.items() if key.isdigit()}
 
 
 class HihatState:

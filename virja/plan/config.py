@@ -15,14 +15,18 @@ relative to the config file).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import msgspec
+
+from virja import tomlconf
 from virja.config import load_config, section
 from virja.errors import ConfigError
+from virja.kit_file import KitFile
 from virja.resources import motions_dir
+from virja.tomlconf import Schema, convert, schema_of
 
 HAND_PIECES: tuple[str, ...] = (
     "snare",
@@ -36,76 +40,6 @@ HAND_PIECES: tuple[str, ...] = (
 HANDS: tuple[str, ...] = ("right_hand", "left_hand")
 STRING_NAMES = frozenset({"E", "A", "D", "G", "B", "C"})
 FOOT_KINDS = {("kick", "right_foot"): "kick", ("hihat", "left_foot"): "hihat_pedal"}
-
-
-def _load_toml(path: Path) -> dict[str, Any]:
-    try:
-        with path.open("rb") as fh:
-            return tomllib.load(fh)
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{path}: not UTF-8 text: {exc.reason}") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
-    except ValueError as exc:  # a path with a NUL byte
-        raise ConfigError(f"{path!r}: cannot read: {exc}") from exc
-
-
-# -- typed access: a value of the wrong type anywhere is a ConfigError naming the key ------
-
-
-def _what(value: object) -> str:
-    return f"{type(value).__name__} {value!r}"[:80]
-
-
-def _table(value: object, where: str, key: str) -> dict[str, Any]:
-    if not isinstance(value, dict):
-        raise ConfigError(f"{where}: {key} must be a table, got {_what(value)}")
-    return value
-
-
-def _list(value: object, where: str, key: str) -> list[Any]:
-    if not isinstance(value, list):
-        raise ConfigError(f"{where}: {key} must be a list, got {_what(value)}")
-    return value
-
-
-def _str(value: object, where: str, key: str) -> str:
-    if not isinstance(value, str):
-        raise ConfigError(f"{where}: {key} must be a string, got {_what(value)}")
-    return value
-
-
-def _opt_str(value: object, where: str, key: str) -> str | None:
-    return None if value is None else _str(value, where, key)
-
-
-def _int(value: object, where: str, key: str) -> int:
-    """A TOML integer (a bool, a float or a string is refused, not converted)."""
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(f"{where}: {key} must be an integer, got {_what(value)}")
-    return value
-
-
-def _float(value: object, where: str, key: str) -> float:
-    """A finite number (TOML integer or float); NaN, inf, bools and strings are refused."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{where}: {key} must be a number, got {_what(value)}")
-    try:
-        out = float(value)
-    except OverflowError:  # an integer beyond float range
-        raise ConfigError(f"{where}: {key} = {value} is out of range") from None
-    if not math.isfinite(out):
-        raise ConfigError(f"{where}: {key} must be finite, got {value!r}")
-    return out
-
-
-def _need(data: dict[str, Any], where: str, key: str, prefix: str = "") -> Any:
-    try:
-        return data[key]
-    except KeyError:
-        raise ConfigError(f"{where}: missing {prefix}{key}") from None
 
 
 @dataclass(frozen=True)
@@ -301,60 +235,93 @@ class PlanConfig:
     timing: Timing
 
 
+# -- the files' schemas (virja.tomlconf): types, required and unknown keys ------------
+
+
+class StringTable(Schema):
+    """``{ name = "E", open = 28 }``"""
+
+    name: str
+    open: int
+
+
+class TuningTable(Schema):
+    strings: list[StringTable]
+
+
+FingeringTable = schema_of(Fingering)
+
+
+class BassFile(Schema):
+    """motions/bass.toml"""
+
+    default_tuning: str
+    frets: int
+    double_stop_span_frets: int
+    tunings: dict[str, TuningTable]
+    fingering: FingeringTable = msgspec.field(default_factory=FingeringTable)  # type: ignore[valid-type]
+
+
+class CostsFile(Schema):
+    """motions/drum_costs.toml"""
+
+    motions: list[str]
+    rows: dict[str, dict[str, float]]
+    drop_penalty: float = 1000.0
+
+
+class HandMoveTable(Schema):
+    base_s: float
+    speed_m_s: float
+
+
+MotionTimingTable = schema_of(MotionTiming)
+
+
+class TimingFile(Schema):
+    """motions/timing.toml"""
+
+    reference_bpm: float
+    rest_s: float
+    motion: dict[str, MotionTimingTable]  # type: ignore[valid-type]
+    hand_move: HandMoveTable | None = None
+
+
+class PlanTable(Schema):
+    """The ``[plan]`` table of the config file (docs/virja.example.toml)."""
+
+    bass_tuning: str | None = None
+    bass_strings: list[StringTable] | None = None
+    bass_frets: int | None = None
+    double_stop_span_frets: int | None = None
+    drum_kit: str | None = None
+    drum_costs: str | None = None
+    timing: str | None = None
+
+
+def _strings(strings: list[StringTable]) -> tuple[tuple[str, int], ...]:
+    return tuple((s.name, s.open) for s in strings)
+
+
 def parse_bass(
     data: dict[str, Any], *, tuning: str | None = None, where: str = "bass.toml"
 ) -> BassSetup:
     """The bass of a ``bass.toml`` table, with tuning ``tuning`` (default: its default)."""
-    tunings = _table(_need(data, where, "tunings"), where, "tunings")
-    name = (
-        tuning
-        if tuning is not None
-        else _str(_need(data, where, "default_tuning"), where, "default_tuning")
-    )
-    if name not in tunings:
-        raise ConfigError(f"{where}: unknown bass tuning {name!r}; known: {sorted(tunings)}")
-    chosen = _table(tunings[name], where, f"tunings.{name}")
-    strings = parse_strings(
-        _need(chosen, where, "strings", f"tunings.{name}."), where, f"tunings.{name}.strings"
-    )
+    f = convert(data, BassFile, where)
+    name = f.default_tuning if tuning is None else tuning
+    if name not in f.tunings:
+        raise ConfigError(f"{where}: unknown bass tuning {name!r}; known: {sorted(f.tunings)}")
     return BassSetup(
-        strings,
-        _int(_need(data, where, "frets"), where, "frets"),
-        _int(_need(data, where, "double_stop_span_frets"), where, "double_stop_span_frets"),
-        parse_fingering(_table(data.get("fingering", {}), where, "fingering"), where),
+        _strings(f.tunings[name].strings),
+        f.frets,
+        f.double_stop_span_frets,
+        Fingering(**tomlconf.fields(f.fingering)),
     )
 
 
 def parse_fingering(data: dict[str, Any], where: str) -> Fingering:
     """The ``[fingering]`` table; keys left out keep :class:`Fingering`'s defaults."""
-    ints = ("span_frets", "thumb_position_fret", "thumb_span_frets")
-    floats = (
-        "shift_cost",
-        "shift_cost_per_fret",
-        "position_cost_per_fret",
-        "shift_time_s",
-        "shift_time_per_fret_s",
-        "rushed_shift_cost",
-    )
-    if unknown := sorted(set(data) - set(ints) - set(floats)):
-        raise ConfigError(f"{where}: unknown key(s) in [fingering]: {', '.join(unknown)}")
-    kw: dict[str, Any] = {k: _int(data[k], where, f"fingering.{k}") for k in ints if k in data}
-    kw.update({k: _float(data[k], where, f"fingering.{k}") for k in floats if k in data})
-    return Fingering(**kw)
-
-
-def parse_strings(value: object, where: str, key: str) -> tuple[tuple[str, int], ...]:
-    """A list of ``{name, open}`` tables -> ((name, open MIDI note), ...)."""
-    out = []
-    for i, s in enumerate(_list(value, where, key)):
-        entry = _table(s, where, f"{key}[{i}]")
-        out.append(
-            (
-                _str(_need(entry, where, "name", f"{key}[{i}]."), where, f"{key}[{i}].name"),
-                _int(_need(entry, where, "open", f"{key}[{i}]."), where, f"{key}[{i}].open"),
-            )
-        )
-    return tuple(out)
+    return Fingering(**tomlconf.fields(convert(data, FingeringTable, f"{where} [fingering]")))
 
 
 def _note_number(key: str, where: str) -> int:
@@ -365,63 +332,53 @@ def _note_number(key: str, where: str) -> int:
 
 def parse_kit(data: dict[str, Any], *, where: str = "drum_kit.toml") -> DrumKit:
     """The kit of a ``drum_kit.toml`` table."""
-    prio = _table(data.get("priority", {}), where, "priority")
+    f = convert(data, KitFile, where)
     notes: dict[int, DrumNote] = {}
-    for key, value in _table(data.get("notes", {}), where, "notes").items():
-        k = f"notes.{key}"
-        entry = _table(value, where, k)
-        piece = _str(_need(entry, where, "piece", f"{k}."), where, f"{k}.piece")
-        limb = _opt_str(entry.get("limb"), where, f"{k}.limb")
+    for key, entry in f.notes.items():
+        piece, limb = entry.piece, entry.limb
         if piece == "none" and limb is not None:
             raise ConfigError(f'{where}: drum note {key}: piece "none" (nobody) takes no limb')
         if limb is None and piece not in HAND_PIECES and piece != "none":
             raise ConfigError(f"{where}: drum note {key}: piece {piece!r} is not a hand piece")
         if limb is not None and (piece, limb) not in FOOT_KINDS:
             raise ConfigError(f"{where}: drum note {key}: {piece} cannot be played by {limb}")
-        if "priority" in entry:
-            priority = _int(entry["priority"], where, f"{k}.priority")
-        else:
-            priority = _int(prio.get(piece, 5), where, f"priority.{piece}")
+        priority = f.priority.get(piece, 5) if entry.priority is None else entry.priority
         notes[_note_number(key, where)] = DrumNote(
             piece=piece,
             limb=limb,
             priority=priority,
-            articulation=_opt_str(entry.get("articulation"), where, f"{k}.articulation"),
-            name=_str(entry.get("name", ""), where, f"{k}.name"),
+            articulation=entry.articulation,
+            name=entry.name,
         )
     return DrumKit(notes)
 
 
 def parse_costs(data: dict[str, Any], *, where: str = "drum_costs.toml") -> DrumCosts:
     """The hand cost table of a ``drum_costs.toml`` table (every cost a finite number)."""
-    motions_list = _list(_need(data, where, "motions"), where, "motions")
-    motions = tuple(_str(m, where, f"motions[{i}]") for i, m in enumerate(motions_list))
+    f = convert(data, CostsFile, where)
+    motions = tuple(f.motions)
     expected = {f"{p}_{h}" for p in HAND_PIECES for h in HANDS}
     if set(motions) != expected or len(motions) != 14:
         raise ConfigError(f"{where}: motions must be the 14 <piece>_<hand> motions")
-    rows = _table(_need(data, where, "rows"), where, "rows")
     table = []
     for row_name in (*motions, "none"):
-        if row_name not in rows:
+        if row_name not in f.rows:
             raise ConfigError(f"{where}: rows.{row_name} is missing")
-        row = _table(rows[row_name], where, f"rows.{row_name}")
+        row = f.rows[row_name]
         if set(row) != set(motions):
             raise ConfigError(f"{where}: row {row_name!r} must give all 14 columns")
-        table.append(tuple(_float(row[c], where, f"rows.{row_name}.{c}") for c in motions))
-    drop = _float(data.get("drop_penalty", 1000), where, "drop_penalty")
-    return DrumCosts(motions, tuple(table), drop)
+        table.append(tuple(row[c] for c in motions))
+    return DrumCosts(motions, tuple(table), f.drop_penalty)
 
 
 def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
     """The timing of a ``timing.toml`` table: reference_bpm > 0, rest_s >= 0, and for each
     kind 0 <= min_anticipation_s <= anticipation_s and min_interval_s >= 0 (all finite)."""
+    f = convert(data, TimingFile, where)
     kinds = {}
-    for name, value in _table(_need(data, where, "motion"), where, "motion").items():
+    for name, value in f.motion.items():
         k = f"motion.{name}"
-        v = _table(value, where, k)
-        mt = MotionTiming(
-            *(_float(_need(v, where, f, f"{k}."), where, f"{k}.{f}") for f in _TIMING_FIELDS)
-        )
+        mt = MotionTiming(**tomlconf.fields(value))
         if not 0 <= mt.min_anticipation_s <= mt.anticipation_s:
             raise ConfigError(f"{where}: {k}: need 0 <= min_anticipation_s <= anticipation_s")
         if mt.min_interval_s < 0:
@@ -430,24 +387,17 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
     needed = {*HAND_PIECES, "kick", "hihat_pedal", "pluck"}
     if missing := needed - set(kinds):
         raise ConfigError(f"{where}: timing table lacks motion kinds {sorted(missing)}")
-    bpm = _float(_need(data, where, "reference_bpm"), where, "reference_bpm")
-    if bpm <= 0:
-        raise ConfigError(f"{where}: reference_bpm must be > 0, got {bpm}")
-    rest_s = _float(_need(data, where, "rest_s"), where, "rest_s")
-    if rest_s < 0:
-        raise ConfigError(f"{where}: rest_s must be >= 0, got {rest_s}")
+    if f.reference_bpm <= 0:
+        raise ConfigError(f"{where}: reference_bpm must be > 0, got {f.reference_bpm}")
+    if f.rest_s < 0:
+        raise ConfigError(f"{where}: rest_s must be >= 0, got {f.rest_s}")
     moves: dict[tuple[str, str], float] = {}
-    if "hand_move" in data:
-        hm = _table(data["hand_move"], where, "hand_move")
-        base_s = _float(_need(hm, where, "base_s", "hand_move."), where, "hand_move.base_s")
-        speed = _float(_need(hm, where, "speed_m_s", "hand_move."), where, "hand_move.speed_m_s")
+    if f.hand_move is not None:
+        base_s, speed = f.hand_move.base_s, f.hand_move.speed_m_s
         if base_s < 0 or speed <= 0:
             raise ConfigError(f"{where}: hand_move needs base_s >= 0 and speed_m_s > 0")
         moves = hand_moves(base_s, speed)
-    return Timing(60.0 / bpm, rest_s, kinds, moves)
-
-
-_TIMING_FIELDS = ("anticipation_s", "min_anticipation_s", "min_interval_s")
+    return Timing(60.0 / f.reference_bpm, f.rest_s, kinds, moves)
 
 
 def default_config() -> PlanConfig:
@@ -473,45 +423,25 @@ def plan_config_from_table(
     overrides) and the key.
     """
     base = motions_dir()
+    plan = convert(over, PlanTable, where)
 
-    def table(key: str, default: str) -> tuple[dict[str, Any], str]:
-        path = base / default
-        if key in over:
-            path = (root or Path.cwd()) / _str(over[key], where, key)
-        return _load_toml(path), str(path)
+    def table(given: str | None, default: str) -> tuple[dict[str, Any], str]:
+        path = base / default if given is None else (root or Path.cwd()) / given
+        return tomlconf.read(path), str(path)
 
-    known = {
-        "bass_tuning",
-        "bass_strings",
-        "bass_frets",
-        "double_stop_span_frets",
-        "drum_kit",
-        "drum_costs",
-        "timing",
-    }
-    if unknown := sorted(set(over) - known):
-        raise ConfigError(
-            f"{where}: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}"
-        )
-    tuning = _opt_str(over.get("bass_tuning"), where, "bass_tuning")
     bass_path = base / "bass.toml"
-    bass = parse_bass(_load_toml(bass_path), tuning=tuning, where=str(bass_path))
-    strings = bass.strings
-    if "bass_strings" in over:
-        strings = parse_strings(over["bass_strings"], where, "bass_strings")
+    bass = parse_bass(tomlconf.read(bass_path), tuning=plan.bass_tuning, where=str(bass_path))
     bass = BassSetup(
-        strings,
-        _int(over.get("bass_frets", bass.frets), where, "bass_frets"),
-        _int(
-            over.get("double_stop_span_frets", bass.double_stop_span_frets),
-            where,
-            "double_stop_span_frets",
-        ),
+        bass.strings if plan.bass_strings is None else _strings(plan.bass_strings),
+        bass.frets if plan.bass_frets is None else plan.bass_frets,
+        bass.double_stop_span_frets
+        if plan.double_stop_span_frets is None
+        else plan.double_stop_span_frets,
         bass.fingering,
     )
-    kit, kit_where = table("drum_kit", "drum_kit.toml")
-    costs, costs_where = table("drum_costs", "drum_costs.toml")
-    timing, timing_where = table("timing", "timing.toml")
+    kit, kit_where = table(plan.drum_kit, "drum_kit.toml")
+    costs, costs_where = table(plan.drum_costs, "drum_costs.toml")
+    timing, timing_where = table(plan.timing, "timing.toml")
     return PlanConfig(
         bass=bass,
         kit=parse_kit(kit, where=kit_where),

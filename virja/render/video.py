@@ -23,8 +23,9 @@ import mido
 import numpy as np
 from numpy.typing import NDArray
 
+from virja import midispec
 from virja.errors import ConfigError, NotAvailableError
-from virja.events import ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.events import Event, NoteOn
 
 log = logging.getLogger(__name__)
 
@@ -88,17 +89,8 @@ def events_to_midi(events: Iterable[Event], path: Path, t0_s: float = 0.0) -> No
     msgs: list[tuple[int, int, mido.Message]] = []
     for i, ev in enumerate(events):
         tick = max(0, round((ev.time_s - t0_s) * 1e6 / tempo * tpb))
-        if isinstance(ev, NoteOn):
-            m = mido.Message("note_on", channel=ev.channel, note=ev.note, velocity=ev.velocity)
-        elif isinstance(ev, NoteOff):
-            m = mido.Message("note_off", channel=ev.channel, note=ev.note, velocity=ev.velocity)
-        elif isinstance(ev, ControlChange):
-            m = mido.Message(
-                "control_change", channel=ev.channel, control=ev.control, value=ev.value
-            )
-        elif isinstance(ev, ProgramChange):
-            m = mido.Message("program_change", channel=ev.channel, program=ev.program)
-        else:
+        m = midispec.to_mido(ev)
+        if m is None:
             continue
         msgs.append((tick, i, m))
     msgs.sort(key=lambda x: (x[0], x[1]))

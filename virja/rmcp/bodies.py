@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import ClassVar
 
+from virja.midispec import data_len
 from virja.rmcp.errors import BadBodyError
 
 
@@ -35,18 +36,6 @@ SYSEX_START = 0xF0
 SYSEX_END = 0xF7
 BASS_SAME_AS_ROOT = 255
 
-# data bytes that follow each channel voice status (high nibble): the one table
-# the MIDI validator and the converter share (mido messages/specs.py style)
-CHANNEL_DATA_LEN: dict[int, int] = {
-    0x80: 2,  # note off
-    0x90: 2,  # note on
-    0xA0: 2,  # polyphonic aftertouch
-    0xB0: 2,  # control change
-    0xC0: 1,  # program change
-    0xD0: 1,  # channel aftertouch
-    0xE0: 2,  # pitch bend
-}
-
 
 def _exact(name: str, data: bytes, size: int) -> None:
     if len(data) != size:
@@ -68,7 +57,7 @@ def split_midi(data: bytes) -> tuple[bytes, ...]:
                 "(running status is not allowed)"
             )
         if status < 0xF0:
-            need = CHANNEL_DATA_LEN[status & 0xF0]
+            need = data_len(status)  # the one table (virja.midispec)
             end = i + 1 + need
             if end > n:
                 raise BadBodyError(

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from virja.events import Event, NoteOn
+from virja.midispec import NOTE_ON
 from virja.rmcp.bodies import ClockRequestBody, MidiBody, UnknownBody
 from virja.rmcp.budget import Budget, PeerBudgets, peer_of
 from virja.rmcp.errors import RmcpError
@@ -240,7 +241,7 @@ class Receiver:
         """``dgram`` without the note-ons beyond its peer's note budget (counted as
         ``note_flood``); they are cut from the messages before any event is made."""
         assert self._budgets is not None
-        ons = [i for i, m in enumerate(body.messages) if m[0] & 0xF0 == 0x90 and m[2]]
+        ons = [i for i, m in enumerate(body.messages) if m[0] & 0xF0 == NOTE_ON and m[2]]
         if not ons:
             return dgram
         allowed = self._budgets.notes(peer_of(addr), len(ons), now_us)

@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from virja.events import Beat, Chord, ControlChange, Event, NoteOff, NoteOn, ProgramChange
+from virja.midispec import PROGRAM_CHANGE
 from virja.rmcp.bodies import BeatBody, ChordBody, MidiBody
 from virja.rmcp.seqnum import seq_add
 from virja.rmcp.wire import MAX_BODY, Datagram, event_message, s_to_us
@@ -135,7 +136,7 @@ def schedule_pass(
                 if t <= b.time_s:
                     in_force[(sender, channel)] = program
             for (sender, channel), program in sorted(in_force.items()):
-                repeat = MidiBody((bytes((0xC0 | channel, program)),))
+                repeat = MidiBody((bytes((PROGRAM_CHANGE | channel, program)),))
                 items.append((time_us - lead_us, time_us, n, sender, repeat))
                 n += 1
     for c in chords:

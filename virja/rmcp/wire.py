@@ -16,16 +16,8 @@ import struct
 from dataclasses import dataclass, replace
 from enum import IntFlag
 
-from virja.events import (
-    Beat,
-    Chord,
-    ControlChange,
-    Event,
-    NoteOff,
-    NoteOn,
-    ProgramChange,
-    midi_bytes,
-)
+from virja import midispec
+from virja.events import Beat, Chord, Event
 from virja.rmcp.bodies import (
     BeatBody,
     Body,
@@ -261,27 +253,17 @@ def clock_reply(
 
 
 def midi_events(body: MidiBody, time_s: float, sender: int) -> list[Event]:
-    """NoteOn / NoteOff (incl. velocity-0 note-on) / ControlChange / ProgramChange.
+    """NoteOn / NoteOff (incl. velocity-0 note-on) / ControlChange / ProgramChange,
+    by the one table (:mod:`virja.midispec`).
 
     Other messages (aftertouch, pitch bend, sysex) are valid on the wire and
     ignored here.
     """
     out: list[Event] = []
     for m in body.messages:
-        status = m[0]
-        hi = status & 0xF0
-        ch = status & 0x0F
-        if hi == 0x90:
-            if m[2]:
-                out.append(NoteOn(time_s, ch, m[1], m[2], sender))
-            else:
-                out.append(NoteOff(time_s, ch, m[1], 0, sender))
-        elif hi == 0x80:
-            out.append(NoteOff(time_s, ch, m[1], m[2], sender))
-        elif hi == 0xB0:
-            out.append(ControlChange(time_s, ch, m[1], m[2], sender))
-        elif hi == 0xC0:
-            out.append(ProgramChange(time_s, ch, m[1], sender))
+        ev = midispec.decode(m, time_s=time_s, sender=sender)
+        if ev is not None:
+            out.append(ev)
     return out
 
 
@@ -307,4 +289,4 @@ def to_events(dgram: Datagram, *, time_s: float | None = None) -> list[Event]:
 
 def event_message(event: Event) -> bytes | None:
     """The MIDI bytes of a channel event (None for Beat and Chord)."""
-    return midi_bytes(event)
+    return midispec.encode(event)

@@ -25,6 +25,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
+from virja.midispec import data_len
 from virja.rtpmidi.errors import BadCommandSectionError, BadVersionError, TruncatedError
 
 RTP_HEADER = struct.Struct("!BBHII")  # V P X CC, M PT, seq, timestamp, ssrc
@@ -33,7 +34,6 @@ PAYLOAD_TYPE = 0x61  # 97, the dynamic type Apple and node-rtpmidi use
 FLAG_B, FLAG_J, FLAG_Z, FLAG_P = 0x80, 0x40, 0x20, 0x10
 
 # data bytes after each channel status (high nibble) and system common status
-CHANNEL_DATA_LEN = {0x80: 2, 0x90: 2, 0xA0: 2, 0xB0: 2, 0xC0: 1, 0xD0: 1, 0xE0: 2}
 SYSTEM_DATA_LEN = {0xF1: 1, 0xF2: 2, 0xF3: 1, 0xF4: 0, 0xF5: 0, 0xF6: 0}
 SYSEX_START, SYSEX_END, SYSEX_CANCEL = 0xF0, 0xF7, 0xF4
 SYSEX_ENDINGS = frozenset({SYSEX_START, SYSEX_END, SYSEX_CANCEL})
@@ -190,7 +190,7 @@ def parse_command_section(payload: bytes) -> tuple[tuple[MidiCommand, ...], bool
         if status < 0xF0:
             running = status
             begin = pos
-            pos = _data_bytes(section, pos, CHANNEL_DATA_LEN[status & 0xF0], status)
+            pos = _data_bytes(section, pos, data_len(status), status)
             commands.append(MidiCommand(delta, bytes([status]) + section[begin:pos]))
         elif status in (SYSEX_START, SYSEX_END):
             running = None

@@ -1,0 +1,167 @@
+"""The animators' constant files, each as one schema (virja.tomlconf):
+motions/animation.toml -> :class:`~virja.motion.band.AnimationSettings` and
+motions/drummer_body.toml -> :class:`~virja.motion.drummer_body.BodySettings`.
+
+A wrong type, a missing or an unknown key is a ConfigError naming the file and the
+key path; the reasons for each number are in the files' comments.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from virja import tomlconf
+from virja.errors import ConfigError
+from virja.motion.bassist import BassistSettings
+from virja.tomlconf import Schema
+
+if TYPE_CHECKING:
+    from virja.motion.band import AnimationSettings
+    from virja.motion.drummer_body import BodySettings
+
+Swing = tuple[float, float, float]  # angle (rad), per velocity gain, decay (s)
+
+
+class VelocityTable(Schema):
+    floor: float
+    ceiling: float
+
+
+class TempoTable(Schema):
+    reference_spb: float
+    max_rate: float
+
+
+class IdleTable(Schema):
+    nod_rad: float
+    sway_rad: float
+    sway_period_s: float
+
+
+class KitTable(Schema):
+    head_decay_s: float
+    ride_swing: Swing
+    crash_swing: Swing
+    hihat_swing: Swing
+    hihat_travel_m: float
+    hihat_lead_s: float | None = None  # absent: AnimationSettings' default
+    hihat_hold_open_s: float | None = None
+
+
+class StringsTable(Schema):
+    amplitude_m: float
+    decay_s: float
+
+
+BassistTable = tomlconf.schema_of(BassistSettings)
+
+
+class AnimationFile(Schema):
+    """motions/animation.toml"""
+
+    velocity: VelocityTable
+    tempo: TempoTable
+    idle: IdleTable
+    kit: KitTable
+    strings: StringsTable
+    bassist: BassistTable = msgspec.field(default_factory=BassistTable)  # type: ignore[valid-type]
+
+
+def animation_settings(path: Path) -> AnimationSettings:
+    """The settings of an animation.toml at ``path`` (every time or rate finite and > 0)."""
+    from virja.motion.band import AnimationSettings
+
+    f = tomlconf.load(path, AnimationFile)
+    k = f.kit
+    settings = AnimationSettings(
+        vel_floor=f.velocity.floor,
+        vel_ceiling=f.velocity.ceiling,
+        reference_spb=f.tempo.reference_spb,
+        max_rate=f.tempo.max_rate,
+        nod_rad=f.idle.nod_rad,
+        sway_rad=f.idle.sway_rad,
+        sway_period_s=f.idle.sway_period_s,
+        head_decay_s=k.head_decay_s,
+        swing=(("ride", *k.ride_swing), ("crash", *k.crash_swing), ("hihat", *k.hihat_swing)),
+        hihat_travel_m=k.hihat_travel_m,
+        hihat_lead_s=AnimationSettings.hihat_lead_s if k.hihat_lead_s is None else k.hihat_lead_s,
+        hihat_hold_open_s=(
+            AnimationSettings.hihat_hold_open_s
+            if k.hihat_hold_open_s is None
+            else k.hihat_hold_open_s
+        ),
+        string_amp_m=f.strings.amplitude_m,
+        string_decay_s=f.strings.decay_s,
+        bassist=BassistSettings(**tomlconf.fields(f.bassist)),
+    )
+    positive = {
+        "tempo.reference_spb": settings.reference_spb,
+        "tempo.max_rate": settings.max_rate,
+        "idle.sway_period_s": settings.sway_period_s,
+        "kit.head_decay_s": settings.head_decay_s,
+        "strings.decay_s": settings.string_decay_s,
+        "kit.hihat_lead_s": settings.hihat_lead_s,
+        "kit.hihat_hold_open_s": settings.hihat_hold_open_s,
+    }
+    for name, value in positive.items():
+        if not (math.isfinite(value) and value > 0):
+            raise ConfigError(f"{path}: {name} must be a finite number > 0, got {value}")
+    return settings
+
+
+class TurnTable(Schema):
+    gain: float
+    max_deg: float
+    smooth_s: float
+    chest_share: float
+    head_share: float
+
+
+class BreathTable(Schema):
+    chest_deg: float
+    period_s: float
+
+
+class BeatTable(Schema):
+    spine_deg: float
+    sway_deg: float
+    reference_spb: float
+
+
+class ArmsTable(Schema):
+    engage_s: float
+    release_s: float
+
+
+class DrummerBodyFile(Schema):
+    """motions/drummer_body.toml"""
+
+    turn: TurnTable
+    breath: BreathTable
+    beat: BeatTable
+    arms: ArmsTable
+
+
+def body_settings(path: Path) -> BodySettings:
+    """The settings of a drummer_body.toml at ``path``."""
+    from virja.motion.drummer_body import BodySettings
+
+    f = tomlconf.load(path, DrummerBodyFile)
+    return BodySettings(
+        gain=f.turn.gain,
+        max_turn_deg=f.turn.max_deg,
+        smooth_s=f.turn.smooth_s,
+        chest_share=f.turn.chest_share,
+        head_share=f.turn.head_share,
+        breath_deg=f.breath.chest_deg,
+        breath_period_s=f.breath.period_s,
+        beat_deg=f.beat.spine_deg,
+        sway_deg=f.beat.sway_deg,
+        reference_spb=f.beat.reference_spb,
+        engage_s=f.arms.engage_s,
+        release_s=f.arms.release_s,
+    )

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from virja.geometry import ALL_BASS_STRINGS, GEOMETRY, Geometry
+from virja.geometry import GEOMETRY, Geometry
 from virja.motion import ik, quat
 from virja.motion.bvh import Bvh, BvhJoint, write_bvh
 from virja.motion.skeleton import (
@@ -28,6 +28,16 @@ from virja.motion.skeleton import (
     SKELETON,
     STICK_AXIS_LOCAL,
     STICK_TIP_M,
+)
+from virja.vocab import (
+    ALL_BASS_STRINGS,
+    FOOT_KINDS,
+    FRET_OPEN_CLIP,
+    HAND_PIECES,
+    HANDS,
+    BassPluck,
+    DrumStroke,
+    idle_clip,
 )
 
 FPS = 60.0
@@ -475,9 +485,9 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
     drums.mkdir(parents=True, exist_ok=True)
     bass.mkdir(parents=True, exist_ok=True)
     count = 0
-    for piece in ("snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash"):
-        for side in ("Left", "Right"):
-            limb = f"{side.lower()}_hand"
+    for piece in HAND_PIECES:
+        for limb in HANDS:
+            side = "Left" if limb == "left_hand" else "Right"
             loc, root, imp = hand_stroke(geo, piece, side)
             meta = {
                 "performer": "drums",
@@ -490,15 +500,15 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
             }
             write_clip(
                 drums,
-                f"{piece}_{limb}",
+                DrumStroke(piece, limb).clip,
                 loc,
                 root,
                 meta,
                 f"{piece} struck with the {side.lower()} stick: ready, back-swing, strike, rebound, ready",
             )
             count += 1
-    for piece, side in (("kick", "Right"), ("hihat", "Left")):
-        limb = f"{side.lower()}_foot"
+    for piece, limb in FOOT_KINDS:
+        side = "Left" if limb == "left_foot" else "Right"
         loc, root, imp = foot_stroke(geo, piece, side)
         meta = {
             "performer": "drums",
@@ -511,7 +521,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
         }
         write_clip(
             drums,
-            f"{piece}_{limb}",
+            DrumStroke(piece, limb).clip,
             loc,
             root,
             meta,
@@ -522,7 +532,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
     drummer_ready(body, geo)
     write_clip(
         drums,
-        "idle_drums",
+        idle_clip("drums"),
         np.array([body.local, body.local]),
         body.root,
         {"performer": "drums", "kind": "idle", "impact_s": 0.0, "joints": list(SK.names)},
@@ -543,7 +553,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
             }
             write_clip(
                 bass,
-                f"fret_{s}_{f}",
+                BassPluck(s, f).hold_clip,
                 loc,
                 root,
                 meta,
@@ -562,7 +572,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
         }
         write_clip(
             bass,
-            f"pluck_{s}",
+            BassPluck(s, 0).pluck_clip,
             loc,
             root,
             meta,
@@ -572,7 +582,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
     loc, root, imp = fret_hold(geo, None, 0)
     write_clip(
         bass,
-        "fret_open",
+        FRET_OPEN_CLIP,
         loc,
         root,
         {
@@ -589,7 +599,7 @@ def author(out: Path, geo: Geometry = GEOMETRY) -> int:
     bass_ready(body, geo)
     write_clip(
         bass,
-        "idle_bass",
+        idle_clip("bass"),
         np.array([body.local, body.local]),
         body.root,
         {"performer": "bass", "kind": "idle", "impact_s": 0.0, "joints": list(SK.names)},

@@ -12,10 +12,6 @@ order, which callers preserve with a stable sort).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
-
-Performer = Literal["bass", "drums"]
-PERFORMERS: tuple[Performer, ...] = ("bass", "drums")
 
 
 def _check_7bit(name: str, value: int) -> None:

@@ -29,16 +29,9 @@ from types import MappingProxyType
 
 import numpy as np
 
-Vec = np.ndarray  # (3,) float64, metres
+from virja.vocab import ALL_BASS_STRINGS, OPEN_STRING_NOTES
 
-DRUM_PIECES = ("kick", "snare", "tom_high", "tom_low", "tom_floor")
-CYMBAL_PIECES = ("hihat", "ride", "crash")
-PIECES = DRUM_PIECES + CYMBAL_PIECES
-BASS_STRINGS = ("E", "A", "D", "G")  # the four-string bass (the paper's), the default
-ALL_BASS_STRINGS = ("B", "E", "A", "D", "G", "C")  # low to high: five- and six-string basses
-# sounding MIDI note of each open string in standard tuning (methods.md: E1 A1 D2 G2;
-# B0 and C3 for five and six strings; drop tunings lower a string, see motions/bass.toml)
-OPEN_STRING_NOTES = MappingProxyType({"B": 23, "E": 28, "A": 33, "D": 38, "G": 43, "C": 48})
+Vec = np.ndarray  # (3,) float64, metres
 
 
 def _v(x: float, y: float, z: float) -> Vec:
@@ -284,8 +277,8 @@ def _make_bass(o: Vec) -> UprightBass:
     nut_half_spacing = (-0.024, -0.015, -0.005, 0.005, 0.015, 0.024)
     # and across the bridge: E A D G 30 mm apart, B and C 20 mm outside them
     bridge_half_spacing = (-0.065, -0.045, -0.015, 0.015, 0.045, 0.065)
-    nut = {}
-    bridge = {}
+    nut: dict[str, Vec] = {}
+    bridge: dict[str, Vec] = {}
     for s, dn, db in zip(ALL_BASS_STRINGS, nut_half_spacing, bridge_half_spacing, strict=True):
         # E on the player's left (+x), G on his right; strings arch a little at the bridge
         nut[s] = nut_centre - dn * lateral

@@ -14,12 +14,13 @@ from pathlib import Path
 from typing import Any
 
 from virja.errors import InputFileError
-from virja.events import Event, NoteOff, NoteOn, Performer
+from virja.events import Event, NoteOff, NoteOn
 from virja.midifile import MidiSession, read_midi
 from virja.routing import Router, RoutingConfig
 from virja.routing_hints import routing_hints
 from virja.session import Reveal, reveal_schedule
 from virja.tempo import Tempo
+from virja.vocab import Performer
 
 MIDI_SUFFIXES = frozenset({".mid", ".midi", ".smf", ".kar"})
 PCAP_SUFFIXES = frozenset({".pcap", ".pcapng", ".cap"})

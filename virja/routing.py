@@ -28,8 +28,9 @@ from typing import Any
 
 from virja import tomlconf
 from virja.errors import ConfigError
-from virja.events import Event, NoteOff, NoteOn, Performer, ProgramChange
+from virja.events import Event, NoteOff, NoteOn, ProgramChange
 from virja.tomlconf import Schema
+from virja.vocab import Performer
 
 GM_BASS_PROGRAMS = frozenset(range(32, 40))  # Acoustic Bass .. Synth Bass 2 (0-based)
 DEFAULT_BASS_WORDS = ("bass", "contrabass", "kontrabass", "basse", "bajo", "baixo", "upright")

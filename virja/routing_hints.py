@@ -11,7 +11,8 @@ import statistics
 from collections import defaultdict
 from collections.abc import Iterable, Mapping
 
-from virja.events import NoteOn, Performer
+from virja.events import NoteOn
+from virja.vocab import Performer
 
 BASS_TOP_NOTE = 55  # G3: a bass line lives below it (the open G string is G2, 43)
 # the kit's core in the GM drum map: a drum part is mostly these, from two families or more

@@ -21,11 +21,12 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import IO, TYPE_CHECKING, Protocol
 
-from virja.events import Beat, Chord, Event, NoteOff, NoteOn, Performer
+from virja.events import Beat, Chord, Event, NoteOff, NoteOn
 from virja.faults import close_at_last_line
 from virja.hud import HudTimeline
 from virja.routing import Router
 from virja.tempo import Tempo
+from virja.vocab import Performer
 
 if TYPE_CHECKING:
     from virja.motion.pose import BandPose

@@ -3,24 +3,23 @@
 from __future__ import annotations
 
 from virja.plan.types import PlannedNote
+from virja.vocab import BassPluck, DrumStroke, MotionKey, as_bass_string
 
 
 def drum(motion: str, start: float, impact: float, velocity: int = 96) -> PlannedNote:
-    piece, _, limb = (
-        motion.partition("_left_") if "_left_" in motion else motion.partition("_right_")
-    )
-    side = "left_" if "_left_" in motion else "right_"
+    key = MotionKey.parse(motion)
+    assert isinstance(key, DrumStroke)
     return PlannedNote(
         time=impact,
         performer="drums",
         channel=9,
         note=38,
         velocity=velocity,
-        limb=side + limb,
-        piece=piece,
+        limb=key.limb,
+        piece=key.piece,
         string=None,
         fret=None,
-        motion=motion,
+        motion=key,
         start=start,
         impact=impact,
         cost=0.0,
@@ -39,7 +38,7 @@ def bass(string: str, fret: int, start: float, impact: float, velocity: int = 96
         piece=None,
         string=string,
         fret=fret,
-        motion=f"pluck_{string}_fret{fret}",
+        motion=BassPluck(as_bass_string(string), fret),
         start=start,
         impact=impact,
         cost=0.0,

@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from tests.motion.helpers import bass, drum
-from virja.geometry import BASS_STRINGS, GEOMETRY
+from virja.geometry import GEOMETRY
 from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
+from virja.vocab import BASS_STRINGS, BassPluck, DrumStroke
 
 HAND_PIECES = ("snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash")
 DRUM_MOTIONS = [f"{p}_{h}" for p in HAND_PIECES for h in ("left_hand", "right_hand")] + [
@@ -253,8 +256,14 @@ def test_forget_before_bounds_memory(library: MotionLibrary) -> None:
 
 
 def test_unknown_motion_raises(library: MotionLibrary) -> None:
+    """A key whose clip the library lacks (a piece no clip strikes), or a bass motion
+    given to the drummer, is an UnknownMotionError naming it."""
+    note = drum("snare_left_hand", 1.0, 1.2)
+    cowbell = replace(note, motion=DrumStroke("cowbell", "left_hand"))  # type: ignore[arg-type]
     with pytest.raises(UnknownMotionError, match="cowbell"):
-        BandAnimator(library, body=STILL).add_planned(drum("cowbell_left_hand", 1.0, 1.2))
+        BandAnimator(library, body=STILL).add_planned(cowbell)
+    with pytest.raises(UnknownMotionError, match="pluck_A_fret3"):
+        BandAnimator(library, body=STILL).add_planned(replace(note, motion=BassPluck("A", 3)))
 
 
 def test_default_library_is_shared() -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from tests.motion.helpers import bass
 from virja.events import NoteOn
-from virja.geometry import ALL_BASS_STRINGS, GEOMETRY
+from virja.geometry import GEOMETRY
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary, UnknownMotionError
 from virja.motion.metrics import contact_distance
@@ -17,6 +17,7 @@ from virja.plan.planner import OnlinePlanner
 from virja.render.scene import band_scene
 from virja.routing import Router
 from virja.session import Performance
+from virja.vocab import ALL_BASS_STRINGS
 
 TOL = 0.01
 

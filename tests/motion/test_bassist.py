@@ -22,7 +22,7 @@ def _note(string: str, fret: int, impact: float, pos: int | None = None):  # typ
     if pos is not None:
         from dataclasses import replace
 
-        p = replace(p, motion=f"{p.motion}_pos{pos}")
+        p = replace(p, motion=replace(p.motion, position=pos))
     return p
 
 

@@ -12,11 +12,12 @@ from pathlib import Path
 
 import pytest
 
-from virja.events import NoteOn, Performer
+from virja.events import NoteOn
 from virja.midifile import read_midi
 from virja.plan import PlannedNote, PlanReport, plan_notes_with_report
 from virja.routing import Router, route_all
 from virja.tempo import ConstantTempo
+from virja.vocab import Performer
 
 T120 = ConstantTempo(0.5)
 GMD = Path(__file__).parent.parent / "data" / "gmd"

@@ -8,11 +8,12 @@ from collections import Counter
 
 import pytest
 
-from virja.events import Beat, NoteOn, Performer
+from virja.events import Beat, NoteOn
 from virja.plan import OnlinePlanner, PlanConfig, plan_notes, plan_notes_with_report, reveal_time
 from virja.plan import planner as planner_mod
 from virja.plan.timing import anticipation_s
 from virja.tempo import ConstantTempo, TempoMap
+from virja.vocab import Performer
 
 T120 = ConstantTempo(0.5)
 DRUMS = (36, 38, 38, 42, 42, 46, 51, 49, 45, 48, 43, 44, 37)
@@ -139,13 +140,13 @@ def test_replanning_never_changes_a_started_motion() -> None:
     planner = OnlinePlanner(tempo=T120)
     planner.add_note("drums", NoteOn(0.0, 9, 38, 100), now_s=-0.5)
     first = planner.poll(-0.15)
-    assert [p.motion for p in first] == ["snare_left_hand"]
+    assert [p.motion.name for p in first] == ["snare_left_hand"]
     # a ride at the same instant arrives after the snare stroke has started: the
     # snare keeps its hand, the ride gets the free one
     planner.add_note("drums", NoteOn(0.0, 9, 51, 100), now_s=-0.1)
     planner.add_note("drums", NoteOn(0.0, 9, 38, 100), now_s=-0.1)  # doubled snare
     rest = planner.flush()
-    assert {p.motion for p in rest} == {"ride_right_hand", "snare_left_hand"}
+    assert {p.motion.name for p in rest} == {"ride_right_hand", "snare_left_hand"}
     twin = next(p for p in rest if p.piece == "snare")
     assert (twin.start, twin.impact, twin.cost) == (first[0].start, first[0].impact, 0.0)
 
@@ -177,7 +178,7 @@ def test_paper_experiments_through_plan_notes() -> None:
 
 def test_bass_paper_example_through_plan_notes() -> None:
     out = plan_notes([("bass", NoteOn(0.0, 0, 29, 100)), ("bass", NoteOn(0.5, 0, 34, 100))], T120)
-    assert [(p.string, p.fret, p.motion, p.cost) for p in out] == [
+    assert [(p.string, p.fret, p.motion.name, p.cost) for p in out] == [
         ("E", 1, "pluck_E_fret1_pos1", 0.0),
         ("A", 1, "pluck_A_fret1_pos1", 1.0),
     ]
@@ -252,7 +253,7 @@ def test_doubled_drum_note_shares_one_stroke() -> None:
 
 def test_feet_play_kick_and_hihat_pedal() -> None:
     notes = [("drums", NoteOn(0.0, 9, 36, 100)), ("drums", NoteOn(0.0, 9, 44, 100))]
-    out = {p.motion: p.limb for p in plan_notes(notes, T120)}
+    out = {p.motion.name: p.limb for p in plan_notes(notes, T120)}
     assert out == {"kick_right_foot": "right_foot", "hihat_left_foot": "left_foot"}
 
 

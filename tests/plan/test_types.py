@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from virja.plan.types import JSON_KEYS, PlannedNote
+from virja.vocab import DrumStroke
 
 P = PlannedNote(
     time=1.0,
@@ -16,7 +17,7 @@ P = PlannedNote(
     piece="snare",
     string=None,
     fret=None,
-    motion="snare_left_hand",
+    motion=DrumStroke("snare", "left_hand"),
     start=0.8,
     impact=1.0,
     cost=0.0,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from virja.events import Performer
 from virja.render.camera import PRESETS, Camera
 from virja.render.director import Shot, camera_at, lerp_camera, plan_shots
+from virja.vocab import Performer
 
 
 def groove(t0: float, t1: float) -> list[tuple[float, Performer, int]]:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from virja.bench import _demo_animator
-from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
+from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import disc_transforms, segment_transforms, sphere_transforms
 from virja.render.renderer import DrawList
@@ -28,6 +28,7 @@ from virja.render.scene import (
     _quat_rotate,
     band_scene,
 )
+from virja.vocab import BASS_STRINGS
 
 F64 = Any
 

@@ -21,7 +21,7 @@ from virja.errors import ConfigError, InputFileError
 from virja.events import Beat
 from virja.export.gltf import Sampled, write_gltf
 from virja.export.musicxml import Score, write_musicxml
-from virja.geometry import BASS_STRINGS, CYMBAL_PIECES, GEOMETRY
+from virja.geometry import GEOMETRY
 from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
 from virja.motion.band import BandAnimator
 from virja.motion.export import performance_to_bvh
@@ -31,6 +31,7 @@ from virja.plan.planner import OnlinePlanner
 from virja.plan.types import PlannedNote
 from virja.routing import Router, RoutingConfig
 from virja.session import Performance, run_schedule
+from virja.vocab import BASS_STRINGS, CYMBAL_PIECES
 
 GLTF_SUFFIXES = (".glb", ".gltf")
 MAX_FPS = 240.0

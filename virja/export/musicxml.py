@@ -34,6 +34,7 @@ from virja.events import Beat
 from virja.plan.config import PlanConfig
 from virja.plan.types import PlannedNote
 from virja.tempo import Tempo
+from virja.vocab import FEET
 
 DIVISIONS = 4  # per quarter note: sixteenth-note resolution
 # sixteenths -> (type, dots), the values a note or rest may take
@@ -69,7 +70,6 @@ NOTATION: dict[tuple[str, str | None], tuple[str, int, str]] = {
     ("crash", None): ("A", 5, "x"),
 }
 STICKING = {"right_hand": "R", "left_hand": "L"}
-FEET = frozenset({"right_foot", "left_foot"})
 
 
 def notation(piece: str, articulation: str | None) -> tuple[str, int, str]:

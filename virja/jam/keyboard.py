@@ -21,7 +21,8 @@ from typing import Literal
 
 from virja import midispec
 from virja.errors import ConfigError
-from virja.events import ControlChange, NoteOff, NoteOn, Performer, ProgramChange
+from virja.events import ControlChange, NoteOff, NoteOn, ProgramChange
+from virja.vocab import Performer
 
 LiveEvent = NoteOn | NoteOff | ControlChange | ProgramChange
 UpperMode = Literal["ignore", "drums"]

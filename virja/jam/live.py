@@ -25,9 +25,10 @@ import socket
 from dataclasses import dataclass
 from typing import Protocol
 
-from virja.events import NoteOn, Performer, ProgramChange
+from virja.events import NoteOn, ProgramChange
 from virja.jam.keyboard import KeyboardLayout, Routed, decode, encode, route
 from virja.rmcp import wire
+from virja.vocab import Performer
 
 log = logging.getLogger(__name__)
 

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from virja.events import Beat, Chord, NoteOff, Performer
+from virja.events import Beat, Chord, NoteOff
 from virja.motion.pose import BandPose
 from virja.plan.types import PlannedNote
 from virja.session import PlanSink
+from virja.vocab import Performer
 
 
 class Fanout:

@@ -26,8 +26,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from virja.errors import NotAvailableError
-from virja.events import Beat, Chord, NoteOff, Performer
+from virja.events import Beat, Chord, NoteOff
 from virja.plan.types import PlannedNote
+from virja.vocab import Performer
 
 log = logging.getLogger(__name__)
 

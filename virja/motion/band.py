@@ -22,14 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from virja.events import Beat
-from virja.geometry import (
-    ALL_BASS_STRINGS,
-    BASS_STRINGS,
-    CYMBAL_PIECES,
-    DRUM_PIECES,
-    GEOMETRY,
-    Geometry,
-)
+from virja.geometry import GEOMETRY, Geometry
 from virja.motion import quat
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
@@ -44,14 +37,23 @@ from virja.motion.skeleton import (
     STICK_TIP_M,
 )
 from virja.motion.timeline import Instance, Timeline, blend_many
+from virja.vocab import (
+    ALL_BASS_STRINGS,
+    BASS_STRINGS,
+    CYMBAL_PIECES,
+    DRUM_PIECES,
+    FRET_OPEN_CLIP,
+    PERFORMER_LIMBS,
+    BassPluck,
+    DrumStroke,
+    MotionKey,
+    Performer,
+    idle_clip,
+)
 
 log = logging.getLogger(__name__)
 
-FIGURES = ("drums", "bass")
-FIGURE_LIMBS = {
-    "drums": ("left_hand", "right_hand", "left_foot", "right_foot"),
-    "bass": ("left_hand", "right_hand"),
-}
+FIGURES: tuple[Performer, ...] = ("drums", "bass")  # the figures' order in poses and exports
 _SK = SKELETON
 _NECK = _SK.index("Neck")
 _HEAD = _SK.index("Head")
@@ -85,7 +87,7 @@ class PlannedNoteLike(Protocol):
     def fret(self) -> int | None: ...
 
     @property
-    def motion(self) -> str: ...
+    def motion(self) -> MotionKey: ...
 
     @property
     def start(self) -> float: ...
@@ -155,11 +157,11 @@ class BandAnimator:
         self.library = library if library is not None else default_library()
         self.geometry = geometry
         self.settings = settings or AnimationSettings.load()
-        self.idle: dict[str, Clip] = {f: self.library[f"idle_{f}"] for f in FIGURES}
+        self.idle: dict[str, Clip] = {f: self.library[idle_clip(f)] for f in FIGURES}
         self.timelines: dict[tuple[str, str], Timeline] = {
             (f, limb): Timeline(_SK.mask(LIMB_JOINTS[limb]).nonzero()[0])
             for f in FIGURES
-            for limb in FIGURE_LIMBS[f]
+            for limb in PERFORMER_LIMBS[f]
         }
         self._roots = np.stack([self.idle[f].root_positions[0] for f in FIGURES])
         self._beat_times: list[float] = []
@@ -220,10 +222,12 @@ class BandAnimator:
         """
         rate = self._rate(p.impact)
         if p.performer == "drums":
-            clip = self.library[p.motion]
+            if not isinstance(p.motion, DrumStroke):
+                raise UnknownMotionError(f"{p.motion.name!r} is not a drummer's limb motion")
+            clip = self.library[p.motion.clip]
             limb = clip.limb or p.limb
-            if clip.performer != "drums" or limb not in FIGURE_LIMBS["drums"]:
-                raise UnknownMotionError(f"{p.motion!r} is not a drummer's limb motion")
+            if clip.performer != "drums" or limb not in PERFORMER_LIMBS["drums"]:
+                raise UnknownMotionError(f"{p.motion.name!r} is not a drummer's limb motion")
             self.timelines[("drums", limb)].add(
                 Instance(
                     clip,
@@ -245,7 +249,9 @@ class BandAnimator:
                     f"a bass note planned on the {p.string!r} string; this bass has "
                     f"{' '.join(self.bass_strings)} (the tuning in [plan] decides)"
                 )
-            pluck = self.library[f"pluck_{p.string}"]
+            if not isinstance(p.motion, BassPluck):
+                raise UnknownMotionError(f"{p.motion.name!r} is not a bassist's motion")
+            pluck = self.library[p.motion.pluck_clip]
             self.timelines[("bass", "right_hand")].add(
                 Instance(
                     pluck,
@@ -260,11 +266,11 @@ class BandAnimator:
             left = self.timelines[("bass", "left_hand")]
             fret = p.fret or 0
             if fret > 0:
-                left.add(self._hold(f"fret_{p.string}_{fret}", p))
+                left.add(self._hold(p.motion.hold_clip, p))
             else:
                 current = left.active(p.start)
                 if current and current[-1].clip.string == p.string:
-                    left.add(self._hold("fret_open", p))
+                    left.add(self._hold(FRET_OPEN_CLIP, p))
             self._add_hit(Hit(p.impact, p.string, p.velocity))
             self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity, p.start)
         else:
@@ -313,7 +319,7 @@ class BandAnimator:
             loc[:] = idle.rotations[0]
             loc[_NECK] = quat.multiply(loc[_NECK], nod[0])
             loc[_HEAD] = quat.multiply(loc[_HEAD], nod[1])
-            for limb in FIGURE_LIMBS[f]:
+            for limb in PERFORMER_LIMBS[f]:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
@@ -399,7 +405,7 @@ class BandAnimator:
             loc[:] = self.idle[f].rotations[0]
             loc[:, _NECK] = quat.multiply(loc[:, _NECK], nod[:, 0])
             loc[:, _HEAD] = quat.multiply(loc[:, _HEAD], nod[:, 1])
-            for limb in FIGURE_LIMBS[f]:
+            for limb in PERFORMER_LIMBS[f]:
                 tl = self.timelines[(f, limb)]
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
@@ -493,7 +499,7 @@ class BandAnimator:
         return out
 
     def _head_hits(self, t: float) -> dict[str, float]:
-        out = dict.fromkeys(DRUM_PIECES, 0.0)
+        out: dict[str, float] = dict.fromkeys(DRUM_PIECES, 0.0)
         tau = self.settings.head_decay_s
         for h in self._recent(t, 8 * tau):
             if h.what in out:

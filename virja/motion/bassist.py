@@ -34,6 +34,7 @@ import numpy as np
 from virja.geometry import Geometry
 from virja.motion import quat
 from virja.motion.skeleton import SKELETON
+from virja.vocab import BassPluck, MotionKey
 
 _SK = SKELETON
 _ARM_LEN = (
@@ -124,15 +125,10 @@ def _two_bone(
     return upper, lower
 
 
-def position_of(motion: str) -> int | None:
-    """The hand position a bass motion name carries (``pluck_A_fret3_pos2`` -> 2; the
-    planner writes it, :func:`virja.plan.bass.motion_name`), None if it carries none."""
-    _, sep, tail = motion.rpartition("_pos")
-    return int(tail) if sep and tail.isdigit() else None
-
-
-def _position_of(motion: str, fret: int) -> int:
-    pos = position_of(motion)
+def _position_of(motion: MotionKey, fret: int) -> int:
+    """The left hand's position the planner chose (:attr:`BassPluck.position`), or the
+    fret's own when it chose none."""
+    pos = motion.position if isinstance(motion, BassPluck) else None
     return pos if pos is not None else max(fret, 1)
 
 
@@ -161,11 +157,11 @@ class Bassist:
         note: int,
         string: str,
         fret: int,
-        motion: str,
+        motion: MotionKey,
         velocity: int,
         start: float | None = None,
     ) -> None:
-        """A planned bass note (its impact, string, fret, motion name, loudness, start)."""
+        """A planned bass note (its impact, string, fret, motion, loudness, start)."""
         i = bisect.bisect_right(self._times, impact)
         finger = (self._notes[i - 1].right_finger + 1) % 2 if i > 0 else 0
         begin = min(impact, start if start is not None else impact - 0.1)

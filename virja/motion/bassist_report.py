@@ -28,9 +28,9 @@ import numpy as np
 
 from virja.motion import quat
 from virja.motion.band import BandAnimator, PlannedNoteLike
-from virja.motion.bassist import position_of
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
+from virja.vocab import BassPluck
 
 _SK = SKELETON
 BOARD_HALF_WIDTH_M = 0.035
@@ -217,7 +217,11 @@ def measure_bassist(
         & (wrist @ front - tip @ front < 0.02)
         & (elbow @ front < 0.0)
     )
-    positions = [position_of(p.motion) for p in sorted(bass, key=lambda p: p.time) if p.fret]
+    positions = [
+        p.motion.position if isinstance(p.motion, BassPluck) else None
+        for p in sorted(bass, key=lambda p: p.time)
+        if p.fret
+    ]
     known = [x for x in positions if x is not None]
     shifts = sum(1 for a, b in zip(known, known[1:], strict=False) if a != b)
     return BassistFigures(

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import time
 
-from virja.geometry import BASS_STRINGS
 from virja.motion.band import BandAnimator
+from virja.vocab import BASS_STRINGS, BassPluck, DrumStroke, MotionKey
 
 
 class _Note:
@@ -14,7 +14,7 @@ class _Note:
     def __init__(
         self,
         performer: str,
-        motion: str,
+        motion: MotionKey,
         limb: str,
         start: float,
         impact: float,
@@ -42,20 +42,45 @@ def busy_animator(seconds: float = 8.0) -> BandAnimator:
     t = 1.0
     i = 0
     while t < seconds:
-        a.add_planned(_Note("drums", "ride_right_hand", "right_hand", t - 0.2, t, piece="ride"))
+        a.add_planned(
+            _Note("drums", DrumStroke("ride", "right_hand"), "right_hand", t - 0.2, t, piece="ride")
+        )
         if i % 4 in (2, 6):
-            a.add_planned(_Note("drums", "snare_left_hand", "left_hand", t - 0.2, t, piece="snare"))
             a.add_planned(
-                _Note("drums", "hihat_left_foot", "left_foot", t - 0.15, t, piece="hihat")
+                _Note(
+                    "drums",
+                    DrumStroke("snare", "left_hand"),
+                    "left_hand",
+                    t - 0.2,
+                    t,
+                    piece="snare",
+                )
+            )
+            a.add_planned(
+                _Note(
+                    "drums",
+                    DrumStroke("hihat", "left_foot"),
+                    "left_foot",
+                    t - 0.15,
+                    t,
+                    piece="hihat",
+                )
             )
         if i % 2 == 0:
             a.add_planned(
-                _Note("drums", "kick_right_foot", "right_foot", t - 0.15, t, piece="kick")
+                _Note(
+                    "drums",
+                    DrumStroke("kick", "right_foot"),
+                    "right_foot",
+                    t - 0.15,
+                    t,
+                    piece="kick",
+                )
             )
             s = BASS_STRINGS[(i // 2) % 4]
             f = 1 + (i * 3) % 12
             a.add_planned(
-                _Note("bass", f"pluck_{s}_fret{f}", "right_hand", t - 0.15, t, string=s, fret=f)
+                _Note("bass", BassPluck(s, f), "right_hand", t - 0.15, t, string=s, fret=f)
             )
         t += spb / 2
         i += 1

@@ -29,15 +29,14 @@ import numpy as np
 
 from virja import tomlconf
 from virja.errors import InputFileError, VirjaError
-from virja.geometry import ALL_BASS_STRINGS, PIECES
 from virja.motion.bvh import Bvh, read_bvh
-from virja.motion.skeleton import LIMB_JOINTS, SKELETON, Skeleton
+from virja.motion.skeleton import SKELETON, Skeleton
 from virja.tomlconf import Schema
+from virja.vocab import ALL_BASS_STRINGS, LIMBS, PERFORMERS, PIECES
 
 log = logging.getLogger(__name__)
 
 KINDS = ("stroke", "hold", "idle")
-PERFORMERS = ("drums", "bass")
 
 
 class ClipError(InputFileError):
@@ -189,10 +188,8 @@ def read_sidecar(path: Path) -> dict[str, Any]:
     if side.kind != "idle":
         if side.limb is None:
             raise _fail(path, text, None, "missing key 'limb'")
-        if side.limb not in LIMB_JOINTS:
-            raise _fail(
-                path, text, "limb", f"limb must be one of {tuple(LIMB_JOINTS)}, got {side.limb!r}"
-            )
+        if side.limb not in LIMBS:
+            raise _fail(path, text, "limb", f"limb must be one of {LIMBS}, got {side.limb!r}")
     if not 0 <= side.impact_s < float("inf"):
         raise _fail(
             path, text, "impact_s", f"impact_s must be finite and >= 0, got {side.impact_s}"

@@ -37,13 +37,13 @@ import numpy as np
 from virja.geometry import GEOMETRY, Geometry
 from virja.motion import quat
 from virja.motion.skeleton import SKELETON
+from virja.vocab import HANDS
 
 _SK = SKELETON
 _HIPS = _SK.index("Hips")
 _SPINE = _SK.index("Spine")
 _CHEST = _SK.index("Chest")
 _NECK = _SK.index("Neck")
-HANDS = ("left_hand", "right_hand")
 _ARMS = {
     "left_hand": tuple(_SK.index(f"Left{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
     "right_hand": tuple(_SK.index(f"Right{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
@@ -300,4 +300,4 @@ def _resolve_arm(
     )
 
 
-__all__ = ["BodySettings", "DrummerBody", "HANDS"]
+__all__ = ["BodySettings", "DrummerBody"]

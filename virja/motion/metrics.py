@@ -22,8 +22,9 @@ import numpy as np
 
 from virja.geometry import Geometry
 from virja.motion import quat
-from virja.motion.band import FIGURE_LIMBS, FIGURES, BandAnimator, PlannedNoteLike, sticks
+from virja.motion.band import FIGURES, BandAnimator, PlannedNoteLike, sticks
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
+from virja.vocab import PERFORMER_LIMBS, DrumStroke
 
 _SK = SKELETON
 CONTACT_TOLERANCE_M = 0.01
@@ -85,7 +86,8 @@ def contact_distance(
     loc = animator.local_rotations(t)
     wpos, wrot = _SK.fk(loc, animator._roots)
     if p.performer == "drums":
-        piece = p.piece or animator.library[p.motion].piece or ""
+        clip = p.motion.clip if isinstance(p.motion, DrumStroke) else p.motion.name
+        piece = p.piece or animator.library[clip].piece or ""
         if p.limb in ("left_hand", "right_hand"):
             tip = sticks(wpos[0], wrot[0])[0 if p.limb == "left_hand" else 1, 1]
             return geo.kit.surface_distance(piece, tip), None
@@ -134,7 +136,7 @@ def continuity(
         return 0.0, 0.0, len(times)
     loc = np.stack([animator.local_rotations(float(t)) for t in times])  # (k, 2, n, 4)
     limb_idx = sorted(
-        {_SK.index(j) for f in FIGURES for limb in FIGURE_LIMBS[f] for j in LIMB_JOINTS[limb]}
+        {_SK.index(j) for f in FIGURES for limb in PERFORMER_LIMBS[f] for j in LIMB_JOINTS[limb]}
     )
     q = loc[:, :, limb_idx]
     rel = quat.multiply(quat.conjugate(q[:-1]), q[1:])
@@ -159,7 +161,7 @@ def measure(
     for p in planned:
         c, f = contact_distance(animator, p, p.impact)
         rep.notes.append(
-            NoteCheck(p.motion, p.impact, c, _timing(animator, p) if timing else 0.0, f)
+            NoteCheck(p.motion.name, p.impact, c, _timing(animator, p) if timing else 0.0, f)
         )
     if planned:
         t0 = min(p.start for p in planned)

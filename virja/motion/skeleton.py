@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from virja.motion import quat
+from virja.vocab import Limb
 
 # name, parent, rest offset from the parent (m), bone radius for drawing (m),
 # largest rotation from rest the joint may take (deg) - a coarse limit checked by
@@ -49,13 +50,12 @@ _JOINTS: tuple[tuple[str, str | None, tuple[float, float, float], float, float],
 )
 
 # joints each limb drives; a limb's motion touches only these (the joint masks)
-LIMB_JOINTS: dict[str, tuple[str, ...]] = {
+LIMB_JOINTS: dict[Limb, tuple[str, ...]] = {
     "left_hand": ("LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand"),
     "right_hand": ("RightShoulder", "RightArm", "RightForeArm", "RightHand"),
     "left_foot": ("LeftUpLeg", "LeftLeg", "LeftFoot"),
     "right_foot": ("RightUpLeg", "RightLeg", "RightFoot"),
 }
-LIMBS = tuple(LIMB_JOINTS)
 
 # Stick held in the fist, in the hand's local frame: from the grip point at the
 # hand's end joint it continues the hand's line (-y) bent 45 deg toward the

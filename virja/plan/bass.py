@@ -36,6 +36,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from virja.plan.config import BassSetup, Fingering
+from virja.vocab import BassPluck, as_bass_string
 
 log = logging.getLogger(__name__)
 
@@ -47,17 +48,10 @@ BassOption = tuple[Position, ...]  # one position per kept note, melody first
 DEFAULT_FINGERING = Fingering()
 
 
-def motion_name(string: str, fret: int, hand: BassState) -> str:
-    """The basic motion's name: ``pluck_<string>_fret<fret>``, and ``_pos<position>``
-    of the left hand once it has one (an open string keeps the hand where it was)."""
-    base = f"pluck_{string}_fret{fret}"
-    return base if hand is None else f"{base}_pos{hand[2]}"
-
-
-def position_of(motion: str) -> int | None:
-    """The hand position a bass motion name carries (None if it carries none)."""
-    _, sep, tail = motion.rpartition("_pos")
-    return int(tail) if sep and tail.isdigit() else None
+def motion_key(string: str, fret: int, hand: BassState) -> BassPluck:
+    """The basic motion: ``string`` plucked at ``fret``, with the left hand's position
+    once it has one (an open string keeps the hand where it was)."""
+    return BassPluck(as_bass_string(string), fret, None if hand is None else hand[2])
 
 
 def fold_into_range(setup: BassSetup, note: int) -> int:

@@ -12,10 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from virja.events import NoteOn
-from virja.plan import bass as bass_mod
 from virja.plan.config import PlanConfig, default_config
 from virja.plan.planner import OnlinePlanner
 from virja.tempo import ConstantTempo
+from virja.vocab import BassPluck
 
 NAMES = ("C", "C#", "D", "Eb", "E", "F", "F#", "G", "Ab", "A", "Bb", "B")
 
@@ -74,7 +74,7 @@ def fingering_table(
     out: list[Fingered] = []
     before: int | None = None
     for p in planned:
-        pos = bass_mod.position_of(p.motion)
+        pos = p.motion.position if isinstance(p.motion, BassPluck) else None
         out.append(
             Fingered(
                 p.note,

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import random
 
-from virja.events import NoteOn, Performer
+from virja.events import NoteOn
 from virja.plan.config import PlanConfig
 from virja.plan.planner import OnlinePlanner
 from virja.plan.types import PlannedNote
+from virja.vocab import Performer
 
 DRUM_NOTES = (36, 38, 42, 46, 51, 49, 45, 48, 43)
 

@@ -27,19 +27,7 @@ from virja.errors import ConfigError
 from virja.kit_file import KitFile
 from virja.resources import motions_dir
 from virja.tomlconf import Schema, convert, schema_of
-
-HAND_PIECES: tuple[str, ...] = (
-    "snare",
-    "hihat",
-    "tom_high",
-    "tom_low",
-    "tom_floor",
-    "ride",
-    "crash",
-)
-HANDS: tuple[str, ...] = ("right_hand", "left_hand")
-STRING_NAMES = frozenset({"E", "A", "D", "G", "B", "C"})
-FOOT_KINDS = {("kick", "right_foot"): "kick", ("hihat", "left_foot"): "hihat_pedal"}
+from virja.vocab import ALL_BASS_STRINGS, FOOT_KINDS, HAND_PIECES, HANDS, DrumStroke, MotionKey
 
 
 @dataclass(frozen=True)
@@ -99,8 +87,10 @@ class BassSetup:
         if not self.strings:
             raise ConfigError("bass needs at least one string")
         for name, open_note in self.strings:
-            if name not in STRING_NAMES:
-                raise ConfigError(f"bass string name {name!r} not one of {sorted(STRING_NAMES)}")
+            if name not in ALL_BASS_STRINGS:
+                raise ConfigError(
+                    f"bass string name {name!r} not one of {sorted(ALL_BASS_STRINGS)}"
+                )
             if not 0 <= open_note <= 127:
                 raise ConfigError(f"bass string {name}: open note {open_note} not 0-127")
         if len({n for n, _ in self.strings}) != len(self.strings):
@@ -156,13 +146,26 @@ class DrumCosts:
     motions: tuple[str, ...]
     table: tuple[tuple[float, ...], ...]
     drop_penalty: float
+    _rows: dict[tuple[str, str], int] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        rows = {}
+        for i, name in enumerate(self.motions):
+            key = MotionKey.parse(name)
+            if isinstance(key, DrumStroke):
+                rows[(key.piece, key.limb)] = i
+        object.__setattr__(self, "_rows", rows)
 
     @property
     def none_row(self) -> int:
         return len(self.motions)
 
     def index(self, piece: str, hand: str) -> int:
-        return self.motions.index(f"{piece}_{hand}")
+        """The row (and column) of the stroke of ``hand`` on ``piece``."""
+        try:
+            return self._rows[(piece, hand)]
+        except KeyError:
+            raise ValueError(f"no hand motion {piece!r} by {hand!r} in the cost table") from None
 
 
 @dataclass(frozen=True)
@@ -357,7 +360,7 @@ def parse_costs(data: dict[str, Any], *, where: str = "drum_costs.toml") -> Drum
     """The hand cost table of a ``drum_costs.toml`` table (every cost a finite number)."""
     f = convert(data, CostsFile, where)
     motions = tuple(f.motions)
-    expected = {f"{p}_{h}" for p in HAND_PIECES for h in HANDS}
+    expected = {DrumStroke(p, h).name for p in HAND_PIECES for h in HANDS}
     if set(motions) != expected or len(motions) != 14:
         raise ConfigError(f"{where}: motions must be the 14 <piece>_<hand> motions")
     table = []

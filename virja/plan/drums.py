@@ -25,8 +25,8 @@ from typing import cast
 
 from virja.plan.bounds import keep_best
 from virja.plan.config import DrumCosts, Timing
+from virja.vocab import Hand
 
-Hand = str  # "left_hand" | "right_hand"
 LEFT: Hand = "left_hand"
 RIGHT: Hand = "right_hand"
 TIME_EPS_S = 1e-9

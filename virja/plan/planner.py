@@ -21,14 +21,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from virja.events import Beat, NoteOn, Performer
+from virja.events import Beat, NoteOn
 from virja.plan import bass as bass_mod
 from virja.plan import drums as drums_mod
 from virja.plan.bounds import DEFAULT_BOUNDS, DensityGate, PlanBounds
 from virja.plan.config import DrumNote, PlanConfig, default_config
 from virja.plan.timing import align
-from virja.plan.types import DroppedNote, DropReason, Limb, MovedNote, PlannedNote, PlanReport
+from virja.plan.types import DroppedNote, DropReason, MovedNote, PlannedNote, PlanReport
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, Tempo
+from virja.vocab import DrumStroke, Performer, as_limb, as_piece
 
 log = logging.getLogger(__name__)
 
@@ -391,7 +392,7 @@ class OnlinePlanner:
                 piece=None,
                 string=name,
                 fret=f,
-                motion=bass_mod.motion_name(name, f, hand),
+                motion=bass_mod.motion_key(name, f, hand),
                 cost=0.0 if paid else cost,
             )
             paid = True
@@ -597,7 +598,7 @@ class OnlinePlanner:
             piece="hihat",
             string=None,
             fret=None,
-            motion="hihat_left_foot",
+            motion=DrumStroke("hihat", "left_foot"),
             cost=0.0,
         )
         if not shared and (foot.state is None or t > foot.state):
@@ -625,11 +626,11 @@ class OnlinePlanner:
         self._emit(
             chain,
             rec,
-            limb=_limb(limb),
+            limb=as_limb(limb),
             piece=piece,
             string=None,
             fret=None,
-            motion=f"{piece}_{limb}",
+            motion=DrumStroke(as_piece(piece), as_limb(limb)),
             cost=0.0,
         )
 
@@ -643,11 +644,11 @@ class OnlinePlanner:
             self._emit(
                 chain,
                 rec,
-                limb=_limb(limb),
+                limb=as_limb(limb),
                 piece=piece,
                 string=None,
                 fret=None,
-                motion=f"{piece}_{limb}",
+                motion=DrumStroke(as_piece(piece), as_limb(limb)),
                 cost=cost if i == 0 else 0.0,
             )
 
@@ -727,7 +728,7 @@ class OnlinePlanner:
         before = [(ft, p) for ft, p in chain.fixed if ft < t - GROUP_EPS_S]
         row = costs.none_row
         if before and t - before[-1][0] < self.config.timing.rest_s:
-            row = costs.motions.index(before[-1][1].motion)
+            row = costs.motions.index(before[-1][1].motion.name)
         choices = [
             (costs.table[row][costs.index(piece, h)], h)
             for h in (drums_mod.LEFT, drums_mod.RIGHT)
@@ -751,18 +752,6 @@ class OnlinePlanner:
             motion=twin.motion,
             cost=0.0,
         )
-
-
-def _limb(name: str) -> Limb:
-    if name == "left_hand":
-        return "left_hand"
-    if name == "right_hand":
-        return "right_hand"
-    if name == "left_foot":
-        return "left_foot"
-    if name == "right_foot":
-        return "right_foot"
-    raise ValueError(f"not a limb: {name!r}")
 
 
 def reveal_time(note: NoteOn, tempo: Tempo, lookahead_beats: float) -> float:

@@ -10,10 +10,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from virja.events import NoteOn, Performer
+from virja.events import NoteOn
+from virja.vocab import LIMBS, Limb, MotionKey, Performer
 
-Limb = Literal["left_hand", "right_hand", "left_foot", "right_foot"]
-LIMBS: tuple[Limb, ...] = ("left_hand", "right_hand", "left_foot", "right_foot")
+__all__ = [
+    "JSON_KEYS",
+    "LIMBS",
+    "DropReason",
+    "DroppedNote",
+    "Limb",
+    "MovedNote",
+    "PlanReport",
+    "PlannedNote",
+]
 
 JSON_KEYS: tuple[str, ...] = (
     "time",
@@ -55,7 +64,7 @@ class PlannedNote:
     piece: str | None
     string: str | None
     fret: int | None
-    motion: str
+    motion: MotionKey
     start: float
     impact: float
     cost: float
@@ -66,6 +75,7 @@ class PlannedNote:
         microsecond (the wire's resolution), so logs carry no float noise; the channel
         1-16 (10 for drums) as every message and option names it (it is 0-15 inside)."""
         out = {key: getattr(self, key) for key in JSON_KEYS}
+        out["motion"] = self.motion.name
         for key in ("time", "start", "impact"):
             out[key] = round(out[key], 6)
         out["channel"] = self.channel + 1  # 1-16, as musicians and every message count
@@ -89,7 +99,7 @@ class PlannedNote:
             piece=data["piece"],
             string=data["string"],
             fret=None if data["fret"] is None else int(data["fret"]),
-            motion=str(data["motion"]),
+            motion=MotionKey.parse(str(data["motion"])),
             start=float(data["start"]),
             impact=float(data["impact"]),
             cost=float(data["cost"]),

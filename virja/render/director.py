@@ -25,8 +25,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from virja.events import Performer
 from virja.render.camera import PRESETS, Camera
+from virja.vocab import Performer
 
 # GM and Roland TD pitches struck in a fill: snare (head, rim, side), toms (head, rim)
 FILL_NOTES = frozenset({37, 38, 40, 41, 43, 45, 47, 48, 50, 58})

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from virja.geometry import BASS_STRINGS, GEOMETRY, Cymbal, Drum, Geometry
+from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
     _cross,
@@ -28,6 +28,7 @@ from virja.render.meshes import (
     sphere_transforms,
 )
 from virja.render.renderer import DrawList
+from virja.vocab import BASS_STRINGS
 
 F64 = NDArray[np.float64]
 

@@ -25,6 +25,7 @@ from virja.errors import ConfigError
 from virja.events import NoteOn
 from virja.input import PerformanceInput, nothing_for_the_band
 from virja.plan.types import PlannedNote, PlanReport
+from virja.vocab import PERFORMERS
 
 PCAP_SUFFIXES = {".pcap", ".pcapng", ".cap"}
 
@@ -124,7 +125,7 @@ def _summary(planned: list[PlannedNote], report: PlanReport, origin_s: float = 0
     lines = [
         f"{who}: {per[who]} notes planned, total cost {cost[who]:g}, "
         f"{sum(1 for p in planned if p.performer == who and p.late)} late"
-        for who in ("bass", "drums")
+        for who in PERFORMERS
     ]
     drops = Counter((d.performer, d.reason) for d in report.dropped)
     lines.append(

@@ -23,7 +23,7 @@ from virja.export.gltf import Sampled, write_gltf
 from virja.export.musicxml import Score, write_musicxml
 from virja.geometry import GEOMETRY
 from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
-from virja.motion.band import BandAnimator
+from virja.motion.band import FIGURES, BandAnimator
 from virja.motion.export import performance_to_bvh
 from virja.plan.config import PlanConfig, load_plan_config
 from virja.plan.immediate import immediate_strokes
@@ -91,7 +91,7 @@ def check_request(
     if bvh is not None:
         _check_out(bvh, "--bvh", (".bvh",))
         stem = bvh.with_suffix("")
-        for fig in ("drums", "bass"):
+        for fig in FIGURES:
             _check_out(stem.parent / f"{stem.name}_{fig}.bvh", "--bvh", (".bvh",))
     if musicxml is not None:
         _check_out(musicxml, "--musicxml", (".musicxml", ".xml"))
@@ -112,7 +112,7 @@ def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None =
     return Sampled(
         times=np.asarray(times, dtype=np.float64),
         local=local,
-        roots=np.stack([animator.idle[f].root_positions[0] for f in ("drums", "bass")]),
+        roots=np.stack([animator.idle[f].root_positions[0] for f in FIGURES]),
         cymbal_swing={
             c: np.array([p.cymbal_swing.get(c, 0.0) for p in poses]) for c in CYMBAL_PIECES
         },

@@ -30,7 +30,7 @@ from virja.motion import quat
 from virja.motion.band import BandAnimator, PlannedNoteLike
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
-from virja.vocab import BassPluck
+from virja.vocab import BASS_STRINGS, BassPluck
 
 _SK = SKELETON
 BOARD_HALF_WIDTH_M = 0.035
@@ -133,8 +133,8 @@ def _neck_frame(
     """(nut centre, along the strings, lateral toward E, out of the board face, board
     length): the fingerboard as render.scene draws it, along the strings."""
     b = animator.geometry.bass
-    nut = np.mean([b.nut[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
-    bridge = np.mean([b.bridge[s] for s in b.strings if s in ("E", "A", "D", "G")], axis=0)
+    nut = np.mean([b.nut[s] for s in b.strings if s in BASS_STRINGS], axis=0)
+    bridge = np.mean([b.bridge[s] for s in b.strings if s in BASS_STRINGS], axis=0)
     along = bridge - nut
     length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
     along = along / np.linalg.norm(along)

@@ -24,7 +24,7 @@ from virja.geometry import Geometry
 from virja.motion import quat
 from virja.motion.band import FIGURES, BandAnimator, PlannedNoteLike, sticks
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
-from virja.vocab import PERFORMER_LIMBS, DrumStroke
+from virja.vocab import HANDS, PERFORMER_LIMBS, DrumStroke
 
 _SK = SKELETON
 CONTACT_TOLERANCE_M = 0.01
@@ -88,7 +88,7 @@ def contact_distance(
     if p.performer == "drums":
         clip = p.motion.clip if isinstance(p.motion, DrumStroke) else p.motion.name
         piece = p.piece or animator.library[clip].piece or ""
-        if p.limb in ("left_hand", "right_hand"):
+        if p.limb in HANDS:
             tip = sticks(wpos[0], wrot[0])[0 if p.limb == "left_hand" else 1, 1]
             return geo.kit.surface_distance(piece, tip), None
         pedal = geo.kit.kick_pedal if piece == "kick" else geo.kit.hihat_pedal

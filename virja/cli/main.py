@@ -43,7 +43,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "dance": ("virja.cli.cmd_dance", "generate motion for new music from a database"),
 }
 
-NOT_YET = 2
+USAGE = 2  # the exit status of `virja` with no command, as argparse exits on bad usage
 
 DESCRIPTION = """\
 virja: a virtual jazz band's bassist and drummer, drawn playing the notes you send.
@@ -59,15 +59,6 @@ examples:
   virja send virja/demo/blues.mid --to 127.0.0.1:50500
 
 `virja COMMAND --help` tells more; docs/ in the source tree has the rest."""
-
-
-def _module_doc(modname: str) -> str | None:
-    try:
-        return importlib.import_module(modname).__doc__
-    except ModuleNotFoundError as exc:
-        if exc.name == modname:
-            return None
-        raise
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -87,15 +78,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         if only is not None and name != only:
             sub.add_parser(name, help=summary, add_help=False)
             continue
-        try:
-            module = importlib.import_module(modname)
-        except ModuleNotFoundError as exc:
-            if exc.name != modname:
-                raise
-            p = sub.add_parser(name, help=f"{summary} (not available yet)", description=summary)
-            p.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
-            p.set_defaults(_not_yet=True)
-            continue
+        module = importlib.import_module(modname)
         p = sub.add_parser(
             name,
             help=summary,
@@ -127,14 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.addLevelName(logging.WARNING, "warning" if not args.verbose else "WARNING")
     if args.command is None:
         parser.print_help()
-        return NOT_YET
-    if getattr(args, "_not_yet", False):
-        print(
-            f"virja {args.command}: not implemented yet in this version "
-            "(see the issue tracker); nothing was done.",
-            file=sys.stderr,
-        )
-        return NOT_YET
+        return USAGE
     try:
         result: int = args._run(args)
         return result

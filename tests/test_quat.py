@@ -5,13 +5,34 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from virja.motion import quat as Q
+from virja import quat as Q
 
 RNG = np.random.default_rng(7)
 
 
 def _rand(n: int) -> np.ndarray:
     return Q.normalize(RNG.normal(size=(n, 4)))
+
+
+def test_rotate_one_is_rotate_for_one_vector() -> None:
+    for q, v in zip(_rand(50), RNG.normal(size=(50, 3)), strict=True):
+        np.testing.assert_allclose(Q.rotate_one(q, v), Q.rotate(q, v), atol=1e-12)
+
+
+def test_rotate_about_is_the_axis_angle_rotation() -> None:
+    axis = RNG.normal(size=(40, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    angle = RNG.uniform(-4.0, 4.0, size=40)
+    v = RNG.normal(size=(40, 3))
+    np.testing.assert_allclose(
+        Q.rotate_about(v, axis, angle), Q.rotate(Q.from_axis_angle(axis, angle), v), atol=1e-12
+    )
+
+
+def test_cross_is_numpys() -> None:
+    a, b = RNG.normal(size=(30, 3)), RNG.normal(size=(30, 3))
+    np.testing.assert_array_equal(Q.cross(a, b), np.cross(a, b))
+    np.testing.assert_array_equal(Q.cross(a, b[0]), np.cross(a, b[0]))
 
 
 def test_multiply_matches_matrix_product() -> None:

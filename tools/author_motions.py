@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from virja import quat
 from virja.geometry import GEOMETRY, Geometry
-from virja.motion import ik, quat
+from virja.motion import ik
 from virja.motion.bvh import Bvh, BvhJoint, write_bvh
 from virja.motion.skeleton import (
     LIMB_JOINTS,

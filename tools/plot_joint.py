@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from virja import quat
 from virja.events import NoteOn
-from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.metrics import in_connection
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON

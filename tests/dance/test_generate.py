@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from virja import quat
 from virja.dance.database import DanceDatabase, DanceError, Segment
 from virja.dance.generate import choose_segment, generate, smooth_join, stretch
 from virja.dance.intervals import CorrectedInterval
 from virja.dance.synth_music import music
-from virja.motion import quat
 
 
 def _new_beats(seed: int, n: int = 16) -> np.ndarray:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from virja import quat
 from virja.dance.capture_styles import STYLES, as_capture
 from virja.dance.retarget import (
     RetargetError,
@@ -16,7 +17,6 @@ from virja.dance.retarget import (
     normalise,
     retarget_to_figure,
 )
-from virja.motion import quat
 from virja.motion.bvh import Bvh, read_bvh, world_pose, write_bvh
 from virja.motion.skeleton import SKELETON
 

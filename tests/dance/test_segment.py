@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from virja import quat
 from virja.dance import segment
 from virja.dance.beats import extract_beats
 from virja.dance.synth_capture import Teacher, make_teacher, min_jerk, off_beats, random_boundaries
-from virja.motion import quat
 
 
 def _cuts(

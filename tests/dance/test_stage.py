@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from virja import quat
 from virja.dance.stage import DANCER_PLACE_XZ, DancerTrack
-from virja.motion import quat
 from virja.motion.bvh import Bvh
 from virja.motion.export import skeleton_joints
 from virja.motion.skeleton import SKELETON

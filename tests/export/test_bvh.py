@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tests.export.conftest import GMD_TAKES, gmd_take
+from virja import quat
 from virja.export import Export, export_performance
-from virja.motion import quat
 from virja.motion.bvh import read_bvh
 from virja.motion.skeleton import SKELETON
 

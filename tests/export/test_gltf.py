@@ -13,8 +13,8 @@ import pygltflib
 import pytest
 
 from tests.export.conftest import GMD_TAKES, VALIDATOR, gmd_take
+from virja import quat
 from virja.export import Export, export_performance
-from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.skeleton import SKELETON
 

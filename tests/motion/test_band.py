@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from tests.motion.helpers import bass, drum
+from virja import quat
 from virja.geometry import GEOMETRY
-from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from tests.motion.helpers import bass
+from virja import quat
 from virja.events import Beat, NoteOff
 from virja.geometry import GEOMETRY
-from virja.motion import quat
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary
 from virja.motion.metrics import contact_distance

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from virja import quat as Q
 from virja.errors import InputFileError
-from virja.motion import quat as Q
 from virja.motion.bvh import Bvh, BvhError, BvhJoint, format_bvh, parse_bvh, read_bvh, write_bvh
 
 SMALL = """HIERARCHY

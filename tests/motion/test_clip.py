@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from virja.motion import quat
+from virja import quat
 from virja.motion.clip import ClipError, MotionLibrary, load_clip
 from virja.resources import motions_dir
 

@@ -72,7 +72,7 @@ def test_continuity_reports_both_kinds_of_frames(library: MotionLibrary) -> None
 
 
 def test_export_writes_one_bvh_per_figure(library: MotionLibrary, tmp_path: Path) -> None:
-    from virja.motion import quat
+    from virja import quat
     from virja.motion.bvh import read_bvh
 
     a = BandAnimator(library)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from virja.motion import quat
+from virja import quat
 from virja.motion.ik import two_bone
 from virja.motion.skeleton import SKELETON as SK
 

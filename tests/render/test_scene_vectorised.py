@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from virja import quat
 from virja.bench import _demo_animator
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
@@ -25,7 +26,6 @@ from virja.render.scene import (
     STRING,
     STRING_HOT,
     _limb_color,
-    _quat_rotate,
     band_scene,
 )
 from virja.vocab import BASS_STRINGS
@@ -156,7 +156,7 @@ def _figure(
         centre = (a + b) / 2
         dl.add("sphere", sphere_transforms([centre], 0.105), SKIN)
         rot = np.asarray(fig.rotations)[names.index("Head")]
-        forward = _quat_rotate(rot, np.array([0.0, 0.0, 1.0]))
+        forward = quat.rotate_one(rot, np.array([0.0, 0.0, 1.0]))
         dl.add("sphere", sphere_transforms([centre + forward * 0.1], 0.022), SKIN)
 
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from virja import quat
 from virja.dance.audio import FloatArray
-from virja.motion import quat
 from virja.motion.bvh import Bvh, BvhJoint, world_pose
 from virja.motion.skeleton import SKELETON
 

@@ -29,9 +29,9 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
+from virja import quat
 from virja.dance.audio import FloatArray
 from virja.dance.segment import local_minima
-from virja.motion import quat
 from virja.motion.bvh import Bvh
 from virja.motion.bvh import world_pose as bvh_world_pose
 

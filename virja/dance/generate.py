@@ -38,12 +38,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from virja import quat
 from virja.dance.ar import ARFitError, sound_parameters
 from virja.dance.audio import ANALYSIS_RATE_HZ, FloatArray
 from virja.dance.beats import extract_beats
 from virja.dance.database import DanceDatabase, DanceError, Segment
 from virja.dance.intervals import CorrectedInterval, correct_intervals
-from virja.motion import quat
 from virja.motion.bvh import Bvh
 
 log = logging.getLogger(__name__)

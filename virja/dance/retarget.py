@@ -35,9 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from virja import quat
 from virja.dance.audio import FloatArray
 from virja.errors import VirjaError
-from virja.motion import quat
 from virja.motion.bvh import Bvh, BvhJoint, world_pose
 from virja.motion.export import skeleton_joints
 from virja.motion.skeleton import SKELETON

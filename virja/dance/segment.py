@@ -33,8 +33,8 @@ from typing import Literal
 
 import numpy as np
 
+from virja import quat
 from virja.dance.audio import FloatArray
-from virja.motion import quat
 
 Parts = Literal["legs", "arms", "all"]
 PARTS: tuple[Parts, ...] = ("legs", "arms", "all")

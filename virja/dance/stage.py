@@ -20,10 +20,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from virja import quat
 from virja.dance.audio import FloatArray
 from virja.dance.database import DanceDatabase
 from virja.dance.generate import Generated, generate
-from virja.motion import quat
 from virja.motion.bvh import Bvh
 from virja.motion.bvh import world_pose as bvh_world_pose
 from virja.motion.pose import FigurePose

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from virja import quat
 from virja.dance.audio import FloatArray
-from virja.motion import quat
 from virja.motion.bvh import Bvh, BvhJoint
 
 FPS = 30.0

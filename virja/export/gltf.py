@@ -39,8 +39,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from virja import quat
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
-from virja.motion import quat
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
 from virja.vocab import BASS_STRINGS
 

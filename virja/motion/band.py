@@ -21,9 +21,9 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from virja import quat
 from virja.events import Beat
 from virja.geometry import GEOMETRY, Geometry
-from virja.motion import quat
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings, DrummerBody

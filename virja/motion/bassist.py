@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from virja import quat
 from virja.geometry import Geometry
-from virja.motion import quat
 from virja.motion.skeleton import SKELETON
 from virja.vocab import BassPluck, MotionKey
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from virja.motion import quat
+from virja import quat
 from virja.motion.band import BandAnimator, PlannedNoteLike
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON

@@ -4,7 +4,7 @@ A :class:`Bvh` holds the hierarchy (joint names, parents, rest offsets,
 channel orders, end sites) and the frames converted to our convention:
 
 - ``rotations``: (n_frames, n_joints, 4) float64 local rotations, w x y z
-  (see :mod:`virja.motion.quat`); the Euler channels of each joint are read
+  (see :mod:`virja.quat`); the Euler channels of each joint are read
   in the file's own order (``Zrotation Xrotation Yrotation`` -> ``R = Rz Rx Ry``);
 - ``positions``: (n_frames, n_joints, 3) float64 local translations in the
   file's units: the position channels where a joint has them (the root's
@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from virja import quat
 from virja.errors import InputFileError
-from virja.motion import quat
 
 _ROT = {"Xrotation": "X", "Yrotation": "Y", "Zrotation": "Z"}
 _POS = {"Xposition": 0, "Yposition": 1, "Zposition": 2}

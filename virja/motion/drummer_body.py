@@ -34,8 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
+from virja import quat
 from virja.geometry import GEOMETRY, Geometry
-from virja.motion import quat
 from virja.motion.skeleton import SKELETON
 from virja.vocab import HANDS
 

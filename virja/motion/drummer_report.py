@@ -27,8 +27,8 @@ from typing import Protocol
 
 import numpy as np
 
+from virja import quat
 from virja.geometry import Cymbal
-from virja.motion import quat
 from virja.motion.band import BandAnimator, PlannedNoteLike, sticks
 from virja.motion.skeleton import SKELETON
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from virja.motion import quat
+from virja import quat
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

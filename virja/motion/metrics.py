@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from virja import quat
 from virja.geometry import Geometry
-from virja.motion import quat
 from virja.motion.band import FIGURES, BandAnimator, PlannedNoteLike, sticks
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
 from virja.vocab import HANDS, PERFORMER_LIMBS, DrumStroke

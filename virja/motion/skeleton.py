@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from virja.motion import quat
+from virja import quat
 from virja.vocab import Limb
 
 # name, parent, rest offset from the parent (m), bone radius for drawing (m),

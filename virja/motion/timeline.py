@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from virja.motion import quat
+from virja import quat
 from virja.motion.clip import Clip, align_signs, sample_frames
 
 

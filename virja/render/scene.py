@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from virja import quat
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
-    _cross,
     box_transforms,
     disc_transforms,
     segment_transforms,
@@ -51,16 +51,6 @@ DRUMMER_SHIRT = (0.16, 0.30, 0.62, 0.1)
 BASSIST_SHIRT = (0.55, 0.42, 0.12, 0.1)
 TROUSERS = (0.10, 0.10, 0.12, 0.1)
 DANCER_SHIRT = (0.55, 0.10, 0.35, 0.1)
-
-
-def _rotation_to(axis: F64) -> F64:
-    """A (3, 3) rotation whose columns are x, y=axis, z."""
-    y = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(y[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    x = np.cross(y, helper)
-    x /= np.linalg.norm(x)
-    z = np.cross(x, y)
-    return np.stack([x, y, z], axis=1)
 
 
 def add_floor(dl: DrawList, size_m: tuple[float, float]) -> None:
@@ -373,7 +363,7 @@ def _kit_rows(geo: Geometry, pose: BandPose) -> tuple[F64, F64, _Parts]:
     if not t.cymbals:
         return cyl, color, _Parts([], [])
     angle = np.array([pose.cymbal_swing.get(n, 0.0) for n in t.cymbals], dtype=np.float64)
-    normal = _rotate_rows(t.normal, t.swing_axis, angle)
+    normal = quat.rotate_about(t.normal, t.swing_axis, angle)
     centre = t.centre.copy()
     if t.hihat >= 0:
         lift = 0.004 + 0.016 * float(np.clip(pose.hihat_open, 0.0, 1.0))
@@ -389,15 +379,6 @@ def _kit_dynamic(dl: DrawList, geo: Geometry, pose: BandPose) -> None:
     if bells.spheres:
         sph, sph_color = _sphere_rows([bells])
         dl.add("sphere", sph, sph_color)
-
-
-def _rotate_rows(v: F64, axis: F64, angle: F64) -> F64:
-    """Rows of ``v`` (n, 3) turned by ``angle`` (n,) about unit ``axis`` rows (Rodrigues)."""
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    cross = _cross(axis, v)
-    dot = np.einsum("ij,ij->i", axis, v)[:, None]
-    out: F64 = v * c + cross * s + axis * dot * (1 - c)
-    return out
 
 
 @dataclass(frozen=True)
@@ -604,22 +585,11 @@ def _figure_parts(fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ..
         # the head: one sphere between the base of the skull and its top, a nose to show where it looks
         centre = (pos[t.head] + pos[t.head_end]) / 2
         rot = np.asarray(fig.rotations)[t.head]
-        forward = _quat_rotate(rot, np.array([0.0, 0.0, 1.0]))
+        forward = quat.rotate_one(rot, np.array([0.0, 0.0, 1.0]))
         parts.spheres.append(
             (np.stack([centre, centre + forward * 0.1]), np.array([0.105, 0.022]), _rows(SKIN, 2))
         )
     return parts
-
-
-def _quat_rotate(q: F64, v: F64) -> F64:
-    """Rotate ``v`` (3,) by the unit quaternion ``q`` (w, x, y, z)."""
-    w, x, y, z = (float(c) for c in q)
-    a, b, c = (float(e) for e in v)
-    # t = u x v + w v, then v + 2 u x t (written out: this runs twice a frame)
-    tx, ty, tz = y * c - z * b + w * a, z * a - x * c + w * b, x * b - y * a + w * c
-    return np.array(
-        [a + 2.0 * (y * tz - z * ty), b + 2.0 * (z * tx - x * tz), c + 2.0 * (x * ty - y * tx)]
-    )
 
 
 def _limb_color(name: str, shirt: tuple[float, ...]) -> tuple[float, ...]:

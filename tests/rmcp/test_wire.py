@@ -15,7 +15,7 @@ from virja.rmcp.bodies import (
     MidiBody,
     UnknownBody,
 )
-from virja.rmcp.signing import load_key, sign, verify
+from virja.rmcp.signing import load_key, sign, tag_matches, verify
 from virja.rmcp.wire import Datagram, Flags, Kind
 
 T = 1_700_000_000_123_456
@@ -107,6 +107,15 @@ def test_signed_golden_verifies_with_key_file() -> None:
     assert d.signed and len(d.tag) == 16
     assert verify(d, key)
     assert not verify(d, b"other key")
+
+
+def test_tag_matches_the_bytes_as_received() -> None:
+    """The receiver's check: the tag over the datagram's bytes as they arrived."""
+    data = golden("midi_signed.bin")
+    key = b"virja-test-key"
+    assert tag_matches(key, data[:-16], data[-16:])
+    assert not tag_matches(key, data[:-17] + bytes([data[-17] ^ 1]), data[-16:])
+    assert not tag_matches(b"other key", data[:-16], data[-16:])
 
 
 def test_sign_builds_the_golden_bytes() -> None:

@@ -13,8 +13,6 @@ by ``event.time_s``.
 
 from __future__ import annotations
 
-import hashlib
-import hmac
 import logging
 from collections import Counter, OrderedDict, deque
 from dataclasses import dataclass, field, replace
@@ -26,7 +24,7 @@ from virja.rmcp.bodies import ClockRequestBody, MidiBody, UnknownBody
 from virja.rmcp.budget import Budget, PeerBudgets, peer_of
 from virja.rmcp.errors import RmcpError
 from virja.rmcp.seqnum import SeqWindow, seq_add, seq_diff
-from virja.rmcp.signing import sign
+from virja.rmcp.signing import sign, tag_matches
 from virja.rmcp.wire import TAG_LEN, Datagram, Kind, clock_reply, kind_name, to_events, us_to_s
 
 KIND_AT = 5  # the kind byte's offset in the header (after magic and version)
@@ -157,8 +155,7 @@ class Receiver:
             if not dgram.signed:
                 self._drop("unsigned", dgram, addr)
                 return
-            expected = hmac.new(key, data[:-TAG_LEN], hashlib.sha256).digest()[:TAG_LEN]
-            if not hmac.compare_digest(expected, dgram.tag):
+            if not tag_matches(key, data[:-TAG_LEN], dgram.tag):
                 self._drop("bad_tag", dgram, addr)
                 return
             if dgram.time_us < now_us - self._max_age_us:

@@ -35,9 +35,15 @@ def sign(dgram: Datagram, key: bytes) -> Datagram:
     return replace(unsigned, tag=tag_of(key, unsigned.header_and_body()))
 
 
+def tag_matches(key: bytes, header_and_body: bytes, tag: bytes) -> bool:
+    """Whether ``tag`` is the tag of ``header_and_body`` (constant-time compare).  The
+    receiver passes the bytes as they arrived (all but the last 16)."""
+    return hmac.compare_digest(tag, tag_of(key, header_and_body))
+
+
 def verify(dgram: Datagram, key: bytes) -> bool:
     """Whether a SIGNED datagram's tag is right (constant-time compare)."""
-    return dgram.signed and hmac.compare_digest(dgram.tag, tag_of(key, dgram.header_and_body()))
+    return dgram.signed and tag_matches(key, dgram.header_and_body(), dgram.tag)
 
 
 def load_key(path: str | Path) -> bytes:

@@ -102,9 +102,6 @@ class Performance:
             self.planner.add_note(performer, event, now_s=now_s)
             self.counts[f"notes_{performer}"] += 1
         elif isinstance(event, NoteOff):
-            add_off = getattr(self.planner, "add_note_off", None)
-            if add_off is not None:
-                add_off(performer, event, now_s=now_s)
             if self.animator is not None:
                 note_off = getattr(self.animator, "note_off", None)
                 if note_off is not None:

@@ -1,8 +1,8 @@
 """Scoring beat times against reference beats: F-measure with a tolerance window.
 
 :func:`match` pairs estimated and reference beats one to one, closest pairs
-first, each within ``window_s`` (70 ms, the usual MIREX window);
-:func:`f_measure` is ``2 P R / (P + R)`` with precision ``P`` = matched /
+first, each within ``window_s`` (70 ms, the usual MIREX window); the
+F-measure of :func:`beat_score` is ``2 P R / (P + R)`` with precision ``P`` = matched /
 estimated and recall ``R`` = matched / reference.  :func:`beat_score` also
 gives the median signed offset (estimate - reference) of the matched pairs,
 the bias of a detector.
@@ -66,8 +66,3 @@ def beat_score(
     f = 2 * p * rc / (p + rc) if p + rc > 0 else 0.0
     offs = [float(est[a]) - float(ref[b]) for a, b in pairs]
     return BeatScore(f, p, rc, n_e, n_r, m, float(np.median(offs)) if offs else float("nan"))
-
-
-def f_measure(est: Sequence[float], ref: Sequence[float], window_s: float = F_WINDOW_S) -> float:
-    """The F-measure of :func:`beat_score`."""
-    return beat_score(est, ref, window_s).f

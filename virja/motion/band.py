@@ -242,7 +242,7 @@ class BandAnimator:
             self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
-                self.hihat.add(p.impact, self.articulations.get(getattr(p, "note", -1)))
+                self.hihat.add(p.impact, self.articulations.get(p.note))
         elif p.performer == "bass":
             if p.string not in self.bass_strings:
                 raise UnknownMotionError(

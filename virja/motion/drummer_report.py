@@ -135,7 +135,7 @@ def _collisions(animator: BandAnimator, pos: np.ndarray, stk: np.ndarray) -> dic
             rel = stk[:, side, 1] - top
             h = rel @ piece.normal
             radial = np.linalg.norm(rel - h[:, None] * piece.normal, axis=1)
-            depth = piece.thickness if isinstance(piece, Cymbal) else getattr(piece, "depth", 0.1)
+            depth = piece.thickness if isinstance(piece, Cymbal) else piece.depth
             hits |= (h < -PENETRATION_M) & (h > -depth - 0.05) & (radial < piece.radius)
         out[f"stick-{name}"] = _runs(hits)
         if isinstance(piece, Cymbal) or name == "kick":

@@ -13,7 +13,7 @@ time (``float`` s): :func:`us_to_s`, used by :func:`to_events`.
 from __future__ import annotations
 
 import struct
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import IntFlag
 
 from virja import midispec
@@ -162,9 +162,6 @@ class Datagram:
         if len(data) > MAX_DATAGRAM:
             raise ValueError(f"datagram of {len(data)} bytes exceeds {MAX_DATAGRAM}")
         return data
-
-    def with_seq(self, seq: int) -> Datagram:
-        return replace(self, seq=seq)
 
     @classmethod
     def parse(cls, data: bytes) -> Datagram:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import itertools
 import json
+import re
+from pathlib import Path
 
 import pytest
 
@@ -138,3 +140,22 @@ def test_a_planned_note_writes_its_key_as_the_name() -> None:
     bad = {**p.to_json(), "motion": "pluck_A"}
     with pytest.raises(ValueError, match="not a motion name"):
         PlannedNote.from_json(bad)
+
+
+# clip or motion names spelled from pieces, limbs, strings or frets
+SPELLED = re.compile(r"""f["'](pluck|fret|idle)_\{|\{piece\}_\{|_\{(limb|hand|side)\}["']""")
+
+
+def test_no_module_spells_a_clip_name() -> None:
+    """Only virja/vocab.py turns pieces, limbs, strings and frets into motion or clip names."""
+    root = Path(__file__).resolve().parent.parent
+    files = [*root.joinpath("virja").rglob("*.py"), *root.joinpath("tools").glob("*.py")]
+    found = [
+        f"{f.relative_to(root)}:{i}: {line.strip()}"
+        for f in files
+        if f.name != "vocab.py"
+        for i, line in enumerate(f.read_text(encoding="utf-8").splitlines(), 1)
+        if SPELLED.search(line)
+    ]
+    assert not found, "\n".join(found)
+    assert SPELLED.search('name = f"pluck_{s}"') and SPELLED.search('f"{piece}_{limb}"')

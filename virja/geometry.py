@@ -13,8 +13,8 @@ Pedals are :class:`Pedal` (heel point, footboard direction, length).
 
 Bass: an upright bass; strings run from the nut to the bridge.  The neck has
 room for six: the four-string E A D G in the middle, a low B beside the E and a
-high C beside the G (``ALL_BASS_STRINGS``); a figure plays and is drawn with the
-strings of its tuning (``BASS_STRINGS``, the four, by default);
+high C beside the G (``virja.vocab.ALL_BASS_STRINGS``); a figure plays and is drawn
+with the strings of its tuning (``virja.vocab.BASS_STRINGS``, the four, by default);
 :meth:`UprightBass.string_point` is where a finger stops a string at a fret
 (equal-temperament distance ``scale * (1 - 2**(-fret/12))`` from the nut),
 :meth:`UprightBass.pluck_point` where the right hand plucks.

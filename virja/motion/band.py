@@ -244,13 +244,14 @@ class BandAnimator:
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
         elif p.performer == "bass":
-            if p.string not in self.bass_strings:
-                raise UnknownMotionError(
-                    f"a bass note planned on the {p.string!r} string; this bass has "
-                    f"{' '.join(self.bass_strings)} (the tuning in [plan] decides)"
-                )
             if not isinstance(p.motion, BassPluck):
                 raise UnknownMotionError(f"{p.motion.name!r} is not a bassist's motion")
+            string = p.motion.string
+            if string not in self.bass_strings:
+                raise UnknownMotionError(
+                    f"a bass note planned on the {string!r} string; this bass has "
+                    f"{' '.join(self.bass_strings)} (the tuning in [plan] decides)"
+                )
             pluck = self.library[p.motion.pluck_clip]
             self.timelines[("bass", "right_hand")].add(
                 Instance(
@@ -269,10 +270,10 @@ class BandAnimator:
                 left.add(self._hold(p.motion.hold_clip, p))
             else:
                 current = left.active(p.start)
-                if current and current[-1].clip.string == p.string:
+                if current and current[-1].clip.string == string:
                     left.add(self._hold(FRET_OPEN_CLIP, p))
-            self._add_hit(Hit(p.impact, p.string, p.velocity))
-            self.bassist.add(p.impact, p.note, p.string, fret, p.motion, p.velocity, p.start)
+            self._add_hit(Hit(p.impact, string, p.velocity))
+            self.bassist.add(p.impact, p.note, string, fret, p.motion, p.velocity, p.start)
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
 

@@ -32,7 +32,16 @@ from virja.errors import InputFileError, VirjaError
 from virja.motion.bvh import Bvh, read_bvh
 from virja.motion.skeleton import SKELETON, Skeleton
 from virja.tomlconf import Schema
-from virja.vocab import ALL_BASS_STRINGS, LIMBS, PERFORMERS, PIECES
+from virja.vocab import (
+    ALL_BASS_STRINGS,
+    LIMBS,
+    PERFORMERS,
+    PIECES,
+    BassString,
+    Limb,
+    Performer,
+    Piece,
+)
 
 log = logging.getLogger(__name__)
 
@@ -60,8 +69,8 @@ class Clip:
     """
 
     name: str
-    performer: str
-    limb: str | None
+    performer: Performer
+    limb: Limb | None
     kind: str
     fps: float
     rotations: np.ndarray
@@ -69,8 +78,8 @@ class Clip:
     impact_s: float
     joints: tuple[str, ...]
     joint_index: np.ndarray
-    piece: str | None = None
-    string: str | None = None
+    piece: Piece | None = None
+    string: BassString | None = None
     fret: int | None = None
     velocity: int = 96
     source: str = "<memory>"

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from virja.events import NoteOn
-from virja.vocab import LIMBS, Limb, MotionKey, Performer
+from virja.vocab import LIMBS, BassString, Limb, MotionKey, Performer, Piece
 
 __all__ = [
     "JSON_KEYS",
@@ -61,8 +61,8 @@ class PlannedNote:
     note: int
     velocity: int
     limb: Limb
-    piece: str | None
-    string: str | None
+    piece: Piece | None
+    string: BassString | None
     fret: int | None
     motion: MotionKey
     start: float

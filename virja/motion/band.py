@@ -349,14 +349,13 @@ class BandAnimator:
     def pose(self, time_s: float) -> BandPose:
         """The band at ``time_s`` (session seconds)."""
         loc = self.local_rotations(time_s)
-        # world rotations stay matrices: a frame converts those of the hands alone
-        wpos, wmat = _SK.fk_matrices(loc, self._roots)
-        figs = [FigurePose(_SK.names, _SK.parents, wpos[i], wmat[i], _SK.radii) for i in range(2)]
+        wpos, wrot = _SK.fk(loc, self._roots)
+        figs = [FigurePose(_SK.names, _SK.parents, wpos[i], wrot[i], _SK.radii) for i in range(2)]
         return BandPose(
             time_s=time_s,
             drums=figs[0],
             bass=figs[1],
-            sticks=_sticks(wpos[0], quat.from_matrix(wmat[0, _STICK_HANDS])),
+            sticks=sticks(wpos[0], wrot[0]),
             hihat_open=self._hihat_open(wpos[0], time_s),
             cymbal_swing=self._swings(time_s),
             head_hits=self._head_hits(time_s),
@@ -436,8 +435,8 @@ class BandAnimator:
         """
         ts = np.asarray(times, dtype=np.float64)
         loc = self.local_rotations_many(ts) if local is None else local
-        wpos, wrot = _SK.fk_matrices(loc, self._roots)
-        all_sticks = _sticks(wpos[:, 0], quat.from_matrix(wrot[:, 0, _STICK_HANDS]))
+        wpos, wrot = _SK.fk(loc, self._roots)
+        all_sticks = sticks(wpos[:, 0], wrot[:, 0])
         out = []
         for k, t in enumerate(ts.tolist()):
             p, r = wpos[k], wrot[k]
@@ -492,19 +491,10 @@ class BandAnimator:
 def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:
     """(..., 2, 2, 3) [left, right] x [butt, tip] stick points from the drummer's FK result
     (``wpos`` (..., n, 3), ``wrot`` (..., n, 4): one frame or many)."""
-    return _sticks(wpos, wrot[..., _STICK_HANDS, :])
-
-
-_STICK_HANDS = [_SK.index("LeftHand"), _SK.index("RightHand")]
-_GRIPS = [_SK.index("LeftHandEnd"), _SK.index("RightHandEnd")]
-
-
-def _sticks(wpos: np.ndarray, hands: np.ndarray) -> np.ndarray:
-    """:func:`sticks` from the world rotations (..., 2, 4) of the left and right hand."""
     out = np.empty(wpos.shape[:-2] + (2, 2, 3))
-    for i in range(2):
-        grip = wpos[..., _GRIPS[i], :]
-        axis = quat.rotate(hands[..., i, :], STICK_AXIS_LOCAL)
+    for i, side in enumerate(("Left", "Right")):
+        grip = wpos[..., _SK.index(f"{side}HandEnd"), :]
+        axis = quat.rotate(wrot[..., _SK.index(f"{side}Hand"), :], STICK_AXIS_LOCAL)
         out[..., i, 0, :] = grip - STICK_BUTT_M * axis
         out[..., i, 1, :] = grip + STICK_TIP_M * axis
     return out

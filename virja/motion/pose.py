@@ -9,11 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
-
-from virja.motion import quat
 
 LEFT_FINGER_BONES = 10  # the fretting hand's bones in ``BandPose.bass_fingers``
 
@@ -26,11 +23,7 @@ class FigurePose:
     - ``parents``: (n,) int64, index of each joint's parent, -1 for the root;
       a bone is drawn from ``positions[parents[i]]`` to ``positions[i]``;
     - ``positions``: (n, 3) float64 world positions of the joints, metres;
-    - ``world``: the world rotations, (n, 4) float64 w x y z, or (n, 3, 3) rotation
-      matrices as forward kinematics makes them (the animator's poses: most
-      frames need the rotation of one or two joints, converted by :meth:`rotation`);
-    - ``rotations``: (n, 4) float64 world rotations, w x y z (from ``world``,
-      converted once when first asked);
+    - ``rotations``: (n, 4) float64 world rotations, w x y z;
     - ``radii``: (n,) float64 radius of the bone ending at each joint, metres
       (for the root: the pelvis' radius).
     """
@@ -38,18 +31,8 @@ class FigurePose:
     names: tuple[str, ...]
     parents: np.ndarray
     positions: np.ndarray
-    world: np.ndarray
+    rotations: np.ndarray
     radii: np.ndarray
-
-    @cached_property
-    def rotations(self) -> np.ndarray:
-        """(n, 4) world rotations, w x y z."""
-        return self.rotation(slice(None))
-
-    def rotation(self, joints: int | slice | np.ndarray) -> np.ndarray:
-        """World rotations (w x y z) of ``joints`` (an index, a slice or an index array)."""
-        w = np.asarray(self.world)[joints]
-        return quat.from_matrix(w) if w.shape[-2:] == (3, 3) else w
 
     def position(self, name: str) -> np.ndarray:
         """(3,) world position of joint ``name``."""

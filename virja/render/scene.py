@@ -602,7 +602,7 @@ def _figure_parts(fig: FigurePose, shirt: tuple[float, ...], skip: tuple[str, ..
     if t.head >= 0:
         # the head: one sphere between the base of the skull and its top, a nose to show where it looks
         centre = (pos[t.head] + pos[t.head_end]) / 2
-        rot = fig.rotation(t.head)
+        rot = np.asarray(fig.rotations)[t.head]
         forward = _quat_rotate(rot, np.array([0.0, 0.0, 1.0]))
         parts.spheres.append(
             (np.stack([centre, centre + forward * 0.1]), np.array([0.105, 0.022]), _rows(SKIN, 2))

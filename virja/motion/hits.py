@@ -31,7 +31,7 @@ class HitTable:
     def __init__(self) -> None:
         self._hits: list[Hit] = []
         self._times: list[float] = []
-        self._by_name: dict[str, tuple[np.ndarray, np.ndarray]] | None = None
+        self._by_name: dict[str, tuple[list[float], np.ndarray, np.ndarray]] | None = None
 
     def __len__(self) -> int:
         return len(self._hits)
@@ -49,23 +49,24 @@ class HitTable:
             del self._times[:k]
             self._by_name = None
 
-    def _arrays(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """(times, velocities) of ``name``'s impacts, in time order (ties as added)."""
+    def _window(self, name: str, t: float, span: float) -> tuple[np.ndarray, np.ndarray]:
+        """``name``'s impacts in [t - span, t]: (times, velocities), in time order (ties
+        as added).  The window is found by bisection in a list (cheaper than numpy for
+        one time), the arrays sliced."""
         if self._by_name is None:
             lists: dict[str, tuple[list[float], list[float]]] = {}
             for h in self._hits:
                 times, vels = lists.setdefault(h.what, ([], []))
                 times.append(h.time)
                 vels.append(float(h.velocity))
-            self._by_name = {k: (np.array(a), np.array(b)) for k, (a, b) in lists.items()}
-        return self._by_name.get(name, (_EMPTY, _EMPTY))
-
-    def _window(self, name: str, t: float, span: float) -> tuple[np.ndarray, np.ndarray]:
-        """``name``'s impacts in [t - span, t]: (times, velocities)."""
-        times, vels = self._arrays(name)
-        lo = int(np.searchsorted(times, t - span, side="left"))
-        hi = int(np.searchsorted(times, t, side="right"))
-        return times[lo:hi], vels[lo:hi]
+            self._by_name = {k: (a, np.array(a), np.array(b)) for k, (a, b) in lists.items()}
+        found = self._by_name.get(name)
+        if found is None:
+            return _EMPTY, _EMPTY
+        keys, time_arr, vel_arr = found
+        lo = bisect.bisect_left(keys, t - span)
+        hi = bisect.bisect_right(keys, t)
+        return time_arr[lo:hi], vel_arr[lo:hi]
 
     def swings(
         self, t: float, swing: Iterable[tuple[str, float, float, float]]
@@ -75,6 +76,9 @@ class HitTable:
         out = {}
         for piece, amp, tau, freq in swing:
             times, vels = self._window(piece, t, 8.0)
+            if not times.size:
+                out[piece] = 0.0
+                continue
             dt = t - times
             terms = amp * vels / 127 * np.exp(-dt / tau) * np.sin(2 * np.pi * freq * dt)
             out[piece] = float(terms.sum())
@@ -86,8 +90,11 @@ class HitTable:
         out = {}
         for piece in pieces:
             times, vels = self._window(piece, t, 8 * tau)
+            if not times.size:
+                out[piece] = 0.0
+                continue
             lit = vels / 127 * np.exp(-(t - times) / tau)
-            out[piece] = max(float(lit.max()), 0.0) if lit.size else 0.0
+            out[piece] = max(float(lit.max()), 0.0)
         return out
 
     def strings(

@@ -354,6 +354,33 @@ def offline_realtime_factor(seconds: float | None = None) -> tuple[float, float]
     return end / wall, end
 
 
+def export_realtime_factor() -> tuple[float, float]:
+    """``virja export`` of the demo to glTF, BVH and MusicXML in this process, as a user
+    runs it (reading, planning, animating, writing; the motion library already loaded):
+    (music seconds / wall seconds, music seconds)."""
+    import contextlib
+    import io
+    import re
+    import tempfile
+
+    from virja.cli.main import main
+
+    with tempfile.TemporaryDirectory(prefix="virja-bench-") as tmp:
+        out = Path(tmp)
+        argv = ["export", demo_path(), "--gltf", str(out / "b.glb"), "--bvh", str(out / "b.bvh")]
+        argv += ["--musicxml", str(out / "b.musicxml")]
+        said = io.StringIO()
+        start = time.perf_counter()
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(io.StringIO()):
+            rc = main(argv)
+        wall = time.perf_counter() - start
+    found = re.search(r"exported ([0-9.]+) s", said.getvalue())
+    if rc != 0 or found is None:
+        return 0.0, 0.0
+    music = float(found.group(1))
+    return music / wall, music
+
+
 def jam_key_to_impact_ms(notes: int = 60) -> tuple[float, str]:
     """Median key-to-impact of ``virja jam`` through JACK (tools/jack_latency.py
     --impact, a checkout's tool with its own dummy JACK server): (ms, note);
@@ -530,6 +557,21 @@ def run_all(
                 load=lf,
             )
         )
+    say("export of the demo")
+    lf = load()
+    export_realtime_factor()  # the first run loads the motion library
+    xrt, music_s = export_realtime_factor()
+    figs.append(
+        Figure(
+            "export_realtime_factor",
+            xrt,
+            "x real time",
+            20.0,
+            True,
+            f"virja export of {music_s:.1f} s of the demo to glTF, BVH and MusicXML",
+            load=lf,
+        )
+    )
     if jam:
         say("jam key to impact (JACK)")
         k2i, why = jam_key_to_impact_ms(30 if quick else 60)

@@ -28,6 +28,7 @@ from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings, DrummerBody
 from virja.motion.drummer_kit import HihatState, default_articulations
+from virja.motion.hits import Hit, HitTable
 from virja.motion.pose import BandPose, FigurePose
 from virja.motion.skeleton import (
     LIMB_JOINTS,
@@ -135,15 +136,6 @@ class AnimationSettings:
         return animation_settings(path)
 
 
-@dataclass(frozen=True)
-class Hit:
-    """An impact for the kit/string state: ``what`` is a piece or a string name."""
-
-    time: float
-    what: str
-    velocity: int
-
-
 class BandAnimator:
     """Turns planned notes and beats into poses.  Not thread-safe; one per session."""
 
@@ -166,8 +158,7 @@ class BandAnimator:
         self._roots = np.stack([self.idle[f].root_positions[0] for f in FIGURES])
         self._beat_times: list[float] = []
         self._beat_spb: list[float] = []
-        self._hits: list[Hit] = []
-        self._hit_times: list[float] = []
+        self._hits = HitTable()
         pedal = geometry.kit.hihat_pedal
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
@@ -239,7 +230,7 @@ class BandAnimator:
                     tag=p,
                 )
             )
-            self._add_hit(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
+            self._hits.add(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
@@ -272,7 +263,7 @@ class BandAnimator:
                 current = left.active(p.start)
                 if current and current[-1].clip.string == string:
                     left.add(self._hold(FRET_OPEN_CLIP, p))
-            self._add_hit(Hit(p.impact, string, p.velocity))
+            self._hits.add(Hit(p.impact, string, p.velocity))
             self.bassist.add(p.impact, p.note, string, fret, p.motion, p.velocity, p.start)
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
@@ -288,11 +279,6 @@ class BandAnimator:
             self.library[name], p.start, p.impact, fade_in=max(p.impact - p.start, 1e-3), tag=p
         )
 
-    def _add_hit(self, h: Hit) -> None:
-        i = bisect.bisect_right(self._hit_times, h.time)
-        self._hit_times.insert(i, h.time)
-        self._hits.insert(i, h)
-
     def forget_before(self, time_s: float) -> None:
         """Drop what can no longer show at ``time_s`` or later (bounds memory in long sessions)."""
         for tl in self.timelines.values():
@@ -301,9 +287,7 @@ class BandAnimator:
         self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
-        k = bisect.bisect_left(self._hit_times, horizon)
-        del self._hits[:k]
-        del self._hit_times[:k]
+        self._hits.forget_before(horizon)
         k = max(bisect.bisect_right(self._beat_times, time_s) - 1, 0)
         del self._beat_times[:k]
         del self._beat_spb[:k]
@@ -411,10 +395,24 @@ class BandAnimator:
                 if len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
         out[:, 0] = self._body(ts, out[:, 0])
-        for k, t in enumerate(ts.tolist()):  # the bassist's body: per frame (IK, not batched)
-            index, phase = self._beat_phase(t)
-            out[k, 1] = self.bassist.body(out[k, 1], self._roots[1], t, phase, index)
+        index, phase = self._beat_phase_many(ts)
+        out[:, 1] = self.bassist.body_many(out[:, 1], self._roots[1], ts, phase, index)
         return out
+
+    def _beat_phase_many(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_beat_phase` over an array of times: (beat numbers, phases)."""
+        bt = np.asarray(self._beat_times, dtype=np.float64)
+        i = np.searchsorted(bt, t, side="right") - 1
+        spb_ref = self.settings.reference_spb
+        index = np.floor(t / spb_ref).astype(np.int64)
+        phase = np.mod(t / spb_ref, 1.0)
+        if bt.size:
+            k = np.maximum(i, 0)
+            p = (t - bt[k]) / np.asarray(self._beat_spb, dtype=np.float64)[k]
+            whole = np.floor(p).astype(np.int64)
+            index = np.where(i >= 0, np.where(p < 1.0, k, k + whole), index)
+            phase = np.where(i >= 0, np.where(p < 1.0, p, np.mod(p, 1.0)), phase)
+        return index, phase
 
     def _nod_many(self, t: np.ndarray) -> np.ndarray:
         """:meth:`_nod` over an array of times: (m, 2, 4)."""
@@ -468,11 +466,6 @@ class BandAnimator:
             )
         return out
 
-    def _recent(self, t: float, window: float) -> list[Hit]:
-        lo = bisect.bisect_left(self._hit_times, t - window)
-        hi = bisect.bisect_right(self._hit_times, t)
-        return self._hits[lo:hi]
-
     def _hihat_open(self, wpos: np.ndarray, t: float) -> float:
         rise = float(wpos[self._ltoe, 1]) - self._hihat_pressed_y
         by_foot = float(min(max(rise / self.settings.hihat_travel_m, 0.0), 1.0))
@@ -482,43 +475,14 @@ class BandAnimator:
         return by_notes + self.hihat.chick_weight(t) * max(by_foot - by_notes, 0.0)
 
     def _swings(self, t: float) -> dict[str, float]:
-        out = {}
-        recent = self._recent(t, 8.0)
-        for piece, amp, tau, freq in self.settings.swing:
-            a = 0.0
-            for h in recent:
-                if h.what == piece:
-                    dt = t - h.time
-                    a += (
-                        amp
-                        * h.velocity
-                        / 127
-                        * math.exp(-dt / tau)
-                        * math.sin(2 * math.pi * freq * dt)
-                    )
-            out[piece] = a
-        return out
+        return self._hits.swings(t, self.settings.swing)
 
     def _head_hits(self, t: float) -> dict[str, float]:
-        out: dict[str, float] = dict.fromkeys(DRUM_PIECES, 0.0)
-        tau = self.settings.head_decay_s
-        for h in self._recent(t, 8 * tau):
-            if h.what in out:
-                out[h.what] = max(out[h.what], h.velocity / 127 * math.exp(-(t - h.time) / tau))
-        return out
+        return self._hits.head_hits(t, DRUM_PIECES, self.settings.head_decay_s)
 
     def _strings(self, t: float) -> dict[str, float]:
-        out = dict.fromkeys(self.bass_strings, 0.0)
         s = self.settings
-        latest: dict[str, Hit] = {}
-        for h in self._recent(t, 8 * s.string_decay_s):
-            if h.what in out:
-                latest[h.what] = h
-        for name, h in latest.items():
-            out[name] = (
-                s.string_amp_m * h.velocity / 127 * math.exp(-(t - h.time) / s.string_decay_s)
-            )
-        return out
+        return self._hits.strings(t, self.bass_strings, s.string_amp_m, s.string_decay_s)
 
     def _stops(self, t: float) -> dict[str, int]:
         out = dict.fromkeys(self.bass_strings, 0)
@@ -543,4 +507,11 @@ def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:
     return out
 
 
-__all__ = ["BandAnimator", "AnimationSettings", "PlannedNoteLike", "sticks", "CYMBAL_PIECES"]
+__all__ = [
+    "BandAnimator",
+    "AnimationSettings",
+    "Hit",
+    "PlannedNoteLike",
+    "sticks",
+    "CYMBAL_PIECES",
+]

@@ -145,6 +145,9 @@ class Bassist:
         self.settings = settings or BassistSettings()
         self._notes: list[_Note] = []
         self._times: list[float] = []
+        self._edits = 0  # note-offs and forgetting: the note table is rebuilt after them
+        self._table: _NoteTable | None = None
+        self._table_key = (0, 0)
         b = geometry.bass
         lateral = np.cross(b.axis, b.front)
         self._lateral = lateral / np.linalg.norm(lateral)  # toward the low strings
@@ -179,10 +182,13 @@ class Bassist:
         for n in reversed(self._notes[max(0, i - 16) : i]):
             if n.off == math.inf and (n.note - note) % 12 == 0:
                 n.off = time_s
+                self._edits += 1
                 return
 
     def forget_before(self, time_s: float) -> None:
         k = max(bisect.bisect_left(self._times, time_s) - 1, 0)
+        if k:
+            self._edits += 1
         del self._notes[:k]
         del self._times[:k]
 
@@ -309,98 +315,184 @@ class Bassist:
         out.append((tip + s.finger_len_m * back - 0.02 * along, thumb_tip))
         return out
 
-    def _vibrato(self, t: float) -> np.ndarray:
-        """Offset (3,) of the fretting hand along its string: vibrato on a long stopped note."""
-        s = self.settings
-        i = bisect.bisect_right(self._times, t)
-        if i == 0:
-            return np.zeros(3)
-        n = self._notes[i - 1]
-        nxt = self._notes[i].start if i < len(self._notes) else math.inf
-        end = min(n.off, nxt)
-        held = t - n.impact
-        if n.fret <= 0 or held < s.vibrato_after_s or end - n.impact < s.long_note_s or t >= end:
-            return np.zeros(3)
-        # fade in over 0.2 s and out over the last 0.1 s before the note ends
-        ramp = min(1.0, (held - s.vibrato_after_s) / 0.2, max(0.0, (end - t) / 0.1))
-        amp = s.vibrato_m * ramp * math.sin(2 * math.pi * s.vibrato_hz * (held - s.vibrato_after_s))
-        return amp * self.geometry.bass.string_dir(n.string)
-
     # -- body -------------------------------------------------------------------
+
+    def _note_table(self) -> _NoteTable:
+        """The notes as arrays (rebuilt when a note or note-off arrives or is forgotten)."""
+        key = (len(self._notes), self._edits)
+        if self._table is None or self._table_key != key:
+            self._table = _NoteTable.of(self._notes, self.geometry)
+            self._table_key = key
+        return self._table
 
     def body(
         self, loc: np.ndarray, root: np.ndarray, t: float, beat_phase: float, beat_index: int
     ) -> np.ndarray:
         """The bassist's local rotations (n, 4) with the living body added and the arms
-        solved again so the hands stay where ``loc`` put them."""
-        s = self.settings
-        wpos, wrot = _SK.fk(loc, root)
-        held = self.fretted(t)
-        last = self.current(t)
-        if last is None:  # before the first note the player stands still
-            return loc
-        # playing: full size; 2 s after the last note the body settles over a second
-        settle = min(max(3.0 - (t - last.impact), 0.0), 1.0)
-        loud = (0.6 + 0.4 * last.velocity / 127) * settle
-        # weight from one foot to the other over two beats; a dip of the spine on each beat
-        two = (beat_index % 2 + beat_phase) / 2.0
-        sway = s.sway_rad * loud * math.sin(2 * math.pi * two)
-        dip = s.dip_rad * loud * math.sin(math.pi * beat_phase) ** 2
-        # the chest turns with the fretting hand: lower on the neck, further toward the bass
-        down = 0.0
-        if held is not None:
-            down = self.geometry.bass.fret_distance(held.fret)
-        turn = s.turn_rad_per_m * down
-        return self._moved(loc, root, wpos, wrot, sway, dip, turn, t)
+        solved again so the hands stay where ``loc`` put them (:meth:`body_many` of one)."""
+        return self.body_many(
+            np.asarray(loc)[None],
+            root,
+            np.array([t], dtype=np.float64),
+            np.array([beat_phase], dtype=np.float64),
+            np.array([beat_index]),
+        )[0]
 
-    def _torso(self, loc: np.ndarray, sway: float, dip: float, turn: float) -> np.ndarray:
+    def body_many(
+        self,
+        loc: np.ndarray,
+        root: np.ndarray,
+        times: np.ndarray,
+        beat_phase: np.ndarray,
+        beat_index: np.ndarray,
+    ) -> np.ndarray:
+        """:meth:`body` at many times at once: ``loc`` (m, n, 4) at ``times`` (m,), with
+        the beat's phase and number at each; one numpy pass over all frames."""
+        s = self.settings
+        loc = np.asarray(loc, dtype=np.float64)
+        t = np.asarray(times, dtype=np.float64)
         out = loc.copy()
-        hips, spine, chest = _SK.index("Hips"), _SK.index("Spine"), _SK.index("Chest")
-        q_sway = quat.from_axis_angle([0.0, 0.0, 1.0], sway)
-        out[hips] = quat.multiply(out[hips], q_sway)
-        legs = [_SK.index("LeftUpLeg"), _SK.index("RightUpLeg")]
-        out[legs] = quat.multiply(quat.conjugate(q_sway), out[legs])  # the legs stay put
-        out[spine] = quat.multiply(out[spine], quat.from_axis_angle([1.0, 0.0, 0.0], dip))
-        out[chest] = quat.multiply(out[chest], quat.from_axis_angle([0.0, 1.0, 0.0], turn))
+        tab = self._note_table()
+        i = np.searchsorted(tab.impact, t, side="right")
+        rows = np.nonzero(i > 0)[0]  # before the first note the player stands still
+        if rows.size == 0:
+            return out
+        t, i, loc = t[rows], i[rows], loc[rows]
+        last = i - 1
+        # playing: full size; 2 s after the last note the body settles over a second
+        settle = np.clip(3.0 - (t - tab.impact[last]), 0.0, 1.0)
+        loud = (0.6 + 0.4 * tab.velocity[last] / 127) * settle
+        # weight from one foot to the other over two beats; a dip of the spine on each beat
+        phase = np.asarray(beat_phase, dtype=np.float64)[rows]
+        two = (np.asarray(beat_index)[rows] % 2 + phase) / 2.0
+        sway = s.sway_rad * loud * np.sin(2 * np.pi * two)
+        dip = s.dip_rad * loud * np.sin(np.pi * phase) ** 2
+        # the chest turns with the fretting hand: lower on the neck, further toward the bass
+        turn = s.turn_rad_per_m * tab.fretted_down(i)
+        out[rows] = self._moved(loc, root, sway, dip, turn, self._vibrato_many(t, last))
         return out
+
+    def _vibrato_many(self, t: np.ndarray, last: np.ndarray) -> np.ndarray:
+        """:meth:`_vibrato` at times ``t`` (m,) whose latest note is ``last`` (m,): (m, 3)."""
+        s = self.settings
+        tab = self._note_table()
+        nxt = np.append(tab.start, math.inf)[last + 1]
+        end = np.minimum(tab.off[last], nxt)
+        impact = tab.impact[last]
+        held = t - impact
+        on = (
+            (tab.fret[last] > 0)
+            & (held >= s.vibrato_after_s)
+            & (end - impact >= s.long_note_s)
+            & (t < end)
+        )
+        # fade in over 0.2 s and out over the last 0.1 s before the note ends
+        ramp = np.minimum(
+            np.minimum(1.0, (held - s.vibrato_after_s) / 0.2), np.maximum(0.0, (end - t) / 0.1)
+        )
+        amp = s.vibrato_m * ramp * np.sin(2 * np.pi * s.vibrato_hz * (held - s.vibrato_after_s))
+        return np.where(on, amp, 0.0)[:, None] * tab.string_dir[last]
 
     def _moved(
         self,
         loc: np.ndarray,
         root: np.ndarray,
-        wpos: np.ndarray,
-        wrot: np.ndarray,
-        sway: float,
-        dip: float,
-        turn: float,
-        t: float,
+        sway: np.ndarray,
+        dip: np.ndarray,
+        turn: np.ndarray,
+        vibrato: np.ndarray,
     ) -> np.ndarray:
-        targets = wpos[_HANDS].copy()
-        targets[0] += self._vibrato(t)
-        out = self._torso(loc, sway, dip, turn)
-        moved_pos, moved_rot = _SK.fk(out, root)
+        wpos, wrot = _SK.fk_matrices(loc, root)
+        targets = wpos[:, _HANDS].copy()
+        targets[:, 0] += vibrato
+        out = _torso(loc, sway, dip, turn)
+        moved_pos, moved_rot = _SK.fk_matrices(out, root)
         # less of it where an arm near full stretch could no longer keep its hand in place:
         # the largest share k of the motion (shoulders move about linearly with it) that
         # leaves both wrists within reach
         reach = _ARM_LEN[0] + _ARM_LEN[1] - 1e-3
-        k = 1.0
+        k = np.ones(len(loc))
         for i in range(2):
-            s0, s1 = wpos[_ARMS[i]], moved_pos[_ARMS[i]]
-            if np.linalg.norm(targets[i] - s1) > reach:
-                lo, hi = 0.0, 1.0
-                for _ in range(12):
-                    mid = 0.5 * (lo + hi)
-                    if np.linalg.norm(targets[i] - (s0 + mid * (s1 - s0))) > reach:
-                        hi = mid
-                    else:
-                        lo = mid
-                k = min(k, lo)
-        if k < 1.0:
-            out = self._torso(loc, k * sway, k * dip, k * turn)
-            moved_pos, moved_rot = _SK.fk(out, root)
-        poles = wpos[_FORES] + (moved_pos[_ARMS] - wpos[_ARMS])
-        upper, lower = _two_bone(moved_pos[_ARMS], targets, poles)
-        out[_ARMS] = quat.multiply(quat.conjugate(moved_rot[_SHOULDERS]), upper)
-        out[_FORES] = quat.multiply(quat.conjugate(upper), lower)
-        out[_HANDS] = quat.multiply(quat.conjugate(lower), wrot[_HANDS])
+            s0, s1 = wpos[:, _ARMS[i]], moved_pos[:, _ARMS[i]]
+            far = np.nonzero(np.linalg.norm(targets[:, i] - s1, axis=-1) > reach)[0]
+            if far.size == 0:
+                continue
+            lo, hi = np.zeros(far.size), np.ones(far.size)
+            a, b, goal = s0[far], s1[far] - s0[far], targets[far, i]
+            for _ in range(12):
+                mid = 0.5 * (lo + hi)
+                out_of_reach = np.linalg.norm(goal - (a + mid[:, None] * b), axis=-1) > reach
+                hi = np.where(out_of_reach, mid, hi)
+                lo = np.where(out_of_reach, lo, mid)
+            k[far] = np.minimum(k[far], lo)
+        less = np.nonzero(k < 1.0)[0]
+        if less.size:
+            kl = k[less]
+            out[less] = _torso(loc[less], kl * sway[less], kl * dip[less], kl * turn[less])
+            moved_pos[less], moved_rot[less] = _SK.fk_matrices(out[less], root)
+        poles = wpos[:, _FORES] + (moved_pos[:, _ARMS] - wpos[:, _ARMS])
+        m = len(loc)
+        upper, lower = _two_bone(
+            moved_pos[:, _ARMS].reshape(-1, 3), targets.reshape(-1, 3), poles.reshape(-1, 3)
+        )
+        upper, lower = upper.reshape(m, 2, 4), lower.reshape(m, 2, 4)
+        shoulders = quat.from_matrix(moved_rot[:, _SHOULDERS])
+        hands = quat.from_matrix(wrot[:, _HANDS])
+        out[:, _ARMS] = quat.multiply(quat.conjugate(shoulders), upper)
+        out[:, _FORES] = quat.multiply(quat.conjugate(upper), lower)
+        out[:, _HANDS] = quat.multiply(quat.conjugate(lower), hands)
         return out
+
+
+_HIPS, _SPINE, _CHEST = _SK.index("Hips"), _SK.index("Spine"), _SK.index("Chest")
+_LEGS = [_SK.index("LeftUpLeg"), _SK.index("RightUpLeg")]
+
+
+def _torso(loc: np.ndarray, sway: np.ndarray, dip: np.ndarray, turn: np.ndarray) -> np.ndarray:
+    """``loc`` (m, n, 4) with the hips swayed, the spine dipped and the chest turned."""
+    out = loc.copy()
+    q_sway = quat.from_axis_angle([0.0, 0.0, 1.0], sway)
+    out[:, _HIPS] = quat.multiply(out[:, _HIPS], q_sway)
+    legs = quat.conjugate(q_sway)[:, None]
+    out[:, _LEGS] = quat.multiply(legs, out[:, _LEGS])  # the legs stay put
+    out[:, _SPINE] = quat.multiply(out[:, _SPINE], quat.from_axis_angle([1.0, 0.0, 0.0], dip))
+    out[:, _CHEST] = quat.multiply(out[:, _CHEST], quat.from_axis_angle([0.0, 1.0, 0.0], turn))
+    return out
+
+
+@dataclass(frozen=True)
+class _NoteTable:
+    """The bassist's notes as arrays, for :meth:`Bassist.body_many`."""
+
+    impact: np.ndarray
+    start: np.ndarray
+    off: np.ndarray
+    velocity: np.ndarray
+    fret: np.ndarray
+    down: np.ndarray  # fret distance from the nut (0 for an open string)
+    string_dir: np.ndarray  # (k, 3)
+    fretted: np.ndarray  # indices of the stopped notes
+
+    @classmethod
+    def of(cls, notes: list[_Note], geometry: Geometry) -> _NoteTable:
+        b = geometry.bass
+        dirs = {s: b.string_dir(s) for s in {n.string for n in notes}}
+        fret = np.array([n.fret for n in notes], dtype=np.int64)
+        return cls(
+            impact=np.array([n.impact for n in notes], dtype=np.float64),
+            start=np.array([n.start for n in notes], dtype=np.float64),
+            off=np.array([n.off for n in notes], dtype=np.float64),
+            velocity=np.array([n.velocity for n in notes], dtype=np.float64),
+            fret=fret,
+            down=np.array([b.fret_distance(n.fret) if n.fret > 0 else 0.0 for n in notes]),
+            string_dir=np.array([dirs[n.string] for n in notes]).reshape(-1, 3),
+            fretted=np.nonzero(fret > 0)[0],
+        )
+
+    def fretted_down(self, i: np.ndarray) -> np.ndarray:
+        """How far down the neck the hand is at times whose notes struck so far are
+        ``[:i]`` (m,): the latest stopped note among the last 32 (:meth:`Bassist.fretted`)."""
+        k = np.searchsorted(self.fretted, i, side="left") - 1
+        j = self.fretted[np.maximum(k, 0)] if self.fretted.size else np.zeros_like(i)
+        found = (k >= 0) & (j >= i - 32)
+        return np.where(found, self.down[j] if self.fretted.size else 0.0, 0.0)

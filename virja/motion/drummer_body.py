@@ -48,6 +48,7 @@ _ARMS = {
     "left_hand": tuple(_SK.index(f"Left{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
     "right_hand": tuple(_SK.index(f"Right{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
 }
+_ARM_JOINTS = [j for hand in HANDS for j in _ARMS[hand]]
 _UP = np.array([0.0, 1.0, 0.0])
 _SIDE = np.array([1.0, 0.0, 0.0])
 
@@ -241,8 +242,13 @@ class DrummerBody:
         chest_local = quat.multiply(chest_turn, quat.from_axis_angle(_SIDE, breath))
         out[:, _CHEST] = quat.multiply(chest_local, out[:, _CHEST])
         out[:, _NECK] = quat.multiply(quat.from_axis_angle(_UP, yaw * s.head_share), out[:, _NECK])
-        p0, r0 = _SK.fk(local, root)
-        p1, r1 = _SK.fk(out, root)
+        # forward kinematics with world rotations as matrices; only the arms' converted
+        p0, m0 = _SK.fk_matrices(local, root)
+        p1, m1 = _SK.fk_matrices(out, root)
+        r0 = np.zeros(m0.shape[:-2] + (4,))
+        r1 = np.zeros_like(r0)
+        r0[:, _ARM_JOINTS] = quat.from_matrix(m0[:, _ARM_JOINTS])
+        r1[:, _ARM_JOINTS] = quat.from_matrix(m1[:, _ARM_JOINTS])
         for hand in HANDS:
             c = self.engagement(hand, t)
             if not np.any(c > 0):

@@ -105,6 +105,14 @@ class Skeleton:
         ``local`` (..., n, 4) w x y z; ``root_position`` (..., 3) metres (the
         root's own offset is ignored: the root sits at ``root_position``).
         """
+        wpos, rw = self.fk_matrices(local, root_position)
+        return wpos, quat.from_matrix(rw)
+
+    def fk_matrices(
+        self, local: np.ndarray, root_position: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`fk` with world rotations as matrices (..., n, 3, 3): callers that need
+        the rotations of a few joints convert only those (``quat.from_matrix``)."""
         # rotation matrices multiply faster than quaternions for these small arrays
         rl = quat.to_matrix(np.asarray(local, dtype=np.float64))
         rw = np.empty_like(rl)
@@ -115,7 +123,7 @@ class Skeleton:
             rp = rw[..., par, :, :]
             rw[..., idx, :, :] = rp @ rl[..., idx, :, :]
             wpos[..., idx, :] = wpos[..., par, :] + (rp @ self._offset_cols[idx])[..., 0]
-        return wpos, quat.from_matrix(rw)
+        return wpos, rw
 
     def rest_positions(self, root_position: np.ndarray | None = None) -> np.ndarray:
         """World positions (n, 3) of the rest pose."""

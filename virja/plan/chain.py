@@ -10,6 +10,8 @@ rules common to all are written here once:
   and passes the caps of :mod:`virja.plan.bounds` (``planner_full``, ``too_dense``);
 - a note not after the chain's last fixed group is placed around the fixed
   motions (the chain's own :meth:`Chain.place_out_of_order`), any other waits;
+- a chain that solves its groups keeps the plan in a :class:`WindowedPlan`
+  (a window of groups per solve, the plan kept until a note arrives);
 - :meth:`Chain.commit` fixes every group whose motion has started by ``now_s``
   (the reveal horizon: start = min over the group's notes, independent of the
   plan), with all earlier groups; :meth:`Chain.fix` does the chain's own fixing
@@ -26,7 +28,7 @@ import logging
 import math
 from abc import ABC, abstractmethod
 from collections import Counter, deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
@@ -63,6 +65,7 @@ class Held:
 
 
 R = TypeVar("R", bound=Held)
+S = TypeVar("S")
 
 
 def group_notes(recs: list[R], window: float = GROUP_EPS_S) -> list[list[R]]:
@@ -132,6 +135,31 @@ class Ledger:
             tuple(sorted(self.counts.items())),
             tuple(sorted(self.unplayed.items())),
         )
+
+
+class WindowedPlan(Generic[S]):
+    """The optimal plan of a chain's pending groups, one step (decision) per group.
+
+    Solved a window of at most ``window_groups`` groups at a time (plan.bounds: the
+    work of one solve is bounded whatever arrives) and kept until a note arrives
+    (:meth:`forget`), so fixing in several steps equals fixing in one, ties included.
+    """
+
+    def __init__(self, window_groups: int) -> None:
+        self.window_groups = window_groups
+        self._steps: list[S] | None = None
+
+    def forget(self) -> None:
+        self._steps = None
+
+    def step(
+        self, groups: list[list[R]], gi: int, solve: Callable[[list[list[R]]], Iterable[S]]
+    ) -> S:
+        """The step of ``groups[gi]``; when none is kept (none yet, or the window's
+        plan is used up) ``solve`` the window starting there first."""
+        if not self._steps:
+            self._steps = list(solve(groups[gi : gi + self.window_groups]))
+        return self._steps.pop(0)
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,7 +13,7 @@ import math
 
 from virja.events import NoteOn
 from virja.plan import bass as bass_mod
-from virja.plan.chain import Chain, ChainContext, Held
+from virja.plan.chain import Chain, ChainContext, Held, WindowedPlan
 
 # one solved group: the option chosen, the cost it paid, the hand after it
 BassStep = tuple[int, float, bass_mod.BassState]
@@ -25,7 +25,7 @@ class BassChain(Chain[Held]):
     def __init__(self, ctx: ChainContext) -> None:
         super().__init__(ctx)
         self.state: bass_mod.BassState = None
-        self.plan: list[BassStep] | None = None
+        self.plan: WindowedPlan[BassStep] = WindowedPlan(ctx.bounds.window_groups)
 
     def held(self, seq: int, note: NoteOn, known_s: float) -> Held:
         """``note`` as this chain holds it: folded into the bass's range (reported
@@ -36,7 +36,7 @@ class BassChain(Chain[Held]):
         return Held(seq, "bass", note, known_s, "pluck", played)
 
     def forget_plan(self) -> None:
-        self.plan = None
+        self.plan.forget()
 
     def _group(self, group: list[Held]) -> tuple[list[int], tuple[bass_mod.BassOption, ...]]:
         pitches = sorted({r.played for r in group}, reverse=True)
@@ -44,11 +44,10 @@ class BassChain(Chain[Held]):
         return pitches[:kept], options
 
     def fix_groups(self, groups: list[list[Held]], n_groups: int) -> None:
-        window = self.ctx.bounds.window_groups  # plan.bounds: one solve, at most this many
         for gi in range(n_groups):
             kept, opts = self._group(groups[gi])
-            if not self.plan:  # none yet, or the window's plan is used up: solve the next
-                win = groups[gi : gi + window]
+
+            def solve(win: list[list[Held]], gi: int = gi) -> list[BassStep]:
                 times = [g[0].note.time_s for g in win]
                 last = groups[gi - 1][0].note.time_s if gi > 0 else self.last_fixed_t
                 gaps = [times[0] - last if last is not None else math.inf]
@@ -59,8 +58,9 @@ class BassChain(Chain[Held]):
                     self.ctx.config.bass.fingering,
                     gaps,
                 )
-                self.plan = list(zip(sol.choice, sol.costs, sol.states, strict=True))
-            choice, cost, state = self.plan.pop(0)
+                return list(zip(sol.choice, sol.costs, sol.states, strict=True))
+
+            choice, cost, state = self.plan.step(groups, gi, solve)
             self._emit_group(groups[gi], kept, opts[choice], cost, state)
             self.state = state
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from virja.plan import drums as drums_mod
-from virja.plan.chain import GROUP_EPS_S, ChainContext
+from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld
 from virja.plan.config import DrumNote
@@ -119,13 +119,13 @@ class HandsChain(DrumChain):
         super().__init__(ctx)
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
-        self.plan: list[HandStep] | None = None
+        self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
 
     def kind(self, drum: DrumNote) -> str:
         return drum.piece
 
     def forget_plan(self) -> None:
-        self.plan = None
+        self.plan.forget()
 
     def _rebounds(self) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
@@ -177,19 +177,19 @@ class HandsChain(DrumChain):
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
             return hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
 
-        window = self.ctx.bounds.window_groups  # plan.bounds: one solve, at most this many
+        def solve(win: list[list[DrumHeld]]) -> list[HandStep]:
+            sol = drums_mod.solve(
+                self.ctx.config.costs,
+                self.ctx.config.timing,
+                self.state,
+                [prepare(g).group for g in win],
+                beam=self.ctx.bounds.beam,
+            )
+            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+
         for gi in range(n_groups):
             hp = prepare(groups[gi])
-            if not self.plan:  # none yet, or the window's plan is used up: solve the next
-                sol = drums_mod.solve(
-                    self.ctx.config.costs,
-                    self.ctx.config.timing,
-                    self.state,
-                    [prepare(g).group for g in groups[gi : gi + window]],
-                    beam=self.ctx.bounds.beam,
-                )
-                self.plan = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-            assignment, stroke_costs, state = self.plan.pop(0)
+            assignment, stroke_costs, state = self.plan.step(groups, gi, solve)
             self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
             self.state = state
 

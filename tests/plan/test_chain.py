@@ -130,7 +130,8 @@ def test_windowed_plan_solves_a_window_at_a_time_and_keeps_it_until_forgotten() 
     groups = [[held(i, float(i))] for i in range(7)]
     solved: list[list[int]] = []
 
-    def solve(win: list[list[Held]]) -> list[int]:
+    def solve(win: list[list[Held]], gi: int) -> list[int]:
+        assert win[0] is groups[gi]
         solved.append([g[0].seq for g in win])
         return [g[0].seq * 10 for g in win]
 

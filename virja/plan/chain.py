@@ -153,12 +153,15 @@ class WindowedPlan(Generic[S]):
         self._steps = None
 
     def step(
-        self, groups: list[list[R]], gi: int, solve: Callable[[list[list[R]]], Iterable[S]]
+        self,
+        groups: list[list[R]],
+        gi: int,
+        solve: Callable[[list[list[R]], int], Iterable[S]],
     ) -> S:
         """The step of ``groups[gi]``; when none is kept (none yet, or the window's
-        plan is used up) ``solve`` the window starting there first."""
+        plan is used up) ``solve(window, gi)`` the window starting there first."""
         if not self._steps:
-            self._steps = list(solve(groups[gi : gi + self.window_groups]))
+            self._steps = list(solve(groups[gi : gi + self.window_groups], gi))
         return self._steps.pop(0)
 
 

@@ -44,22 +44,21 @@ class BassChain(Chain[Held]):
         return pitches[:kept], options
 
     def fix_groups(self, groups: list[list[Held]], n_groups: int) -> None:
+        def solve(win: list[list[Held]], gi: int) -> list[BassStep]:
+            times = [g[0].note.time_s for g in win]
+            last = groups[gi - 1][0].note.time_s if gi > 0 else self.last_fixed_t
+            gaps = [times[0] - last if last is not None else math.inf]
+            gaps += [b - a for a, b in zip(times, times[1:], strict=False)]
+            sol = bass_mod.solve(
+                self.state,
+                [self._group(g)[1] for g in win],
+                self.ctx.config.bass.fingering,
+                gaps,
+            )
+            return list(zip(sol.choice, sol.costs, sol.states, strict=True))
+
         for gi in range(n_groups):
             kept, opts = self._group(groups[gi])
-
-            def solve(win: list[list[Held]], gi: int = gi) -> list[BassStep]:
-                times = [g[0].note.time_s for g in win]
-                last = groups[gi - 1][0].note.time_s if gi > 0 else self.last_fixed_t
-                gaps = [times[0] - last if last is not None else math.inf]
-                gaps += [b - a for a, b in zip(times, times[1:], strict=False)]
-                sol = bass_mod.solve(
-                    self.state,
-                    [self._group(g)[1] for g in win],
-                    self.ctx.config.bass.fingering,
-                    gaps,
-                )
-                return list(zip(sol.choice, sol.costs, sol.states, strict=True))
-
             choice, cost, state = self.plan.step(groups, gi, solve)
             self._emit_group(groups[gi], kept, opts[choice], cost, state)
             self.state = state

@@ -177,7 +177,7 @@ class HandsChain(DrumChain):
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
             return hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
 
-        def solve(win: list[list[DrumHeld]]) -> list[HandStep]:
+        def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
             sol = drums_mod.solve(
                 self.ctx.config.costs,
                 self.ctx.config.timing,

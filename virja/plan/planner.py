@@ -175,7 +175,8 @@ class OnlinePlanner:
 
     def _commit(self, now_s: float) -> None:
         for chain in self._chains:
-            chain.commit(now_s)
+            if chain.min_start <= now_s:  # else nothing pending has started (or none)
+                chain.commit(now_s)
 
 
 def reveal_time(note: NoteOn, tempo: Tempo, lookahead_beats: float) -> float:

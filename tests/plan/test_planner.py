@@ -272,3 +272,28 @@ def test_a_long_session_keeps_bounded_tempo_and_report_history() -> None:
         p.add_beat(Beat(i * 0.5, i // 4, 1 + i % 4, 4, 0, 500_000))
     assert len(p._beat_times) == planner_mod.MAX_BEATS_KEPT
     assert p.seconds_per_beat_at(1e9) == 0.5
+
+
+def test_each_note_goes_to_its_chain_and_an_unknown_performer_is_refused() -> None:
+    planner = OnlinePlanner(tempo=T120)
+    planner.add_note("bass", NoteOn(1.0, 0, 40, 90), now_s=0.0)
+    planner.add_note("drums", NoteOn(1.0, 9, 36, 90), now_s=0.0)  # kick: right foot
+    planner.add_note("drums", NoteOn(1.0, 9, 44, 90), now_s=0.0)  # pedal hi-hat: left foot
+    planner.add_note("drums", NoteOn(1.0, 9, 38, 90), now_s=0.0)  # snare: a hand
+    planner.add_note("drums", NoteOn(1.0, 9, 20, 90), now_s=0.0)  # not in the kit map
+    assert planner.pending_count == 4
+    assert planner.next_deadline() == min(p.start for p in planner.flush())
+    with pytest.raises(ValueError, match="unknown performer"):
+        planner.add_note("piano", NoteOn(1.0, 0, 60, 90), now_s=0.0)  # type: ignore[arg-type]
+    out = plan_notes(
+        [
+            ("drums", NoteOn(1.0, 9, 36, 90)),
+            ("drums", NoteOn(1.0, 9, 44, 90)),
+            ("drums", NoteOn(1.0, 9, 38, 90)),
+            ("bass", NoteOn(1.0, 0, 40, 90)),
+        ],
+        T120,
+    )
+    limbs = {p.note: p.limb for p in out}
+    assert (limbs[40], limbs[36], limbs[44]) == ("right_hand", "right_foot", "left_foot")
+    assert limbs[38] in ("left_hand", "right_hand")

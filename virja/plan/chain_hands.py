@@ -1,0 +1,275 @@
+"""The drummer's hands: the chain of the online planner that chooses a hand per stroke.
+
+Its state is :data:`virja.plan.drums.HandState` (what each hand struck last, and
+when).  Notes within HAND_WINDOW_S of a group's first are one decision: notes of
+one piece within SAME_STROKE_S are one stroke; the two most important strokes
+go to the solver (:func:`virja.plan.drums.solve`, over at most
+``bounds.window_groups`` groups, the plan kept until a note arrives), a further
+stroke on a planned piece bounces off it, a third piece is more than two hands
+can strike.  Before that, soft notes close after a stroke on their piece are set
+aside as its rebounds (a buzz, a press roll), and a crowded hi-hat goes to the
+left foot (:meth:`virja.plan.chain_feet.FootChain.chick`).  Shared rules:
+:mod:`virja.plan.chain`, :mod:`virja.plan.chain_kit`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from virja.plan import drums as drums_mod
+from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
+from virja.plan.chain_feet import FootChain
+from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld
+from virja.plan.config import DrumNote
+from virja.plan.types import DropReason
+
+# Notes of one piece this close are one stroke heard twice (head and rim, a pad's
+# double trigger): the later ones ride on the first stroke, each at its own time.
+SAME_STROKE_S = 0.010
+# A soft hand note (a ghost note) this soon after another note on the same piece is
+# part of a buzz or press roll: the same hand presses, the stick bounces.
+BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
+BUZZ_S = 0.050
+BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
+
+# one solved group: the hand per stroke (None: dropped), their costs, the state after
+HandStep = tuple[drums_mod.Assignment, tuple[float, ...], drums_mod.HandState]
+
+
+def velocity_priority(priority: int, velocity: int) -> int:
+    """A note's priority weighed by its velocity (lower = more important): a ghost
+    note (velocity < 40) gives way first, a soft one (< 64) next, an accent (>= 100)
+    is kept before a plain stroke of its piece."""
+    if velocity < 40:
+        return priority + 3
+    if velocity < 64:
+        return priority + 1
+    if velocity >= 100:
+        return max(0, priority - 1)
+    return priority
+
+
+@dataclass(frozen=True, slots=True)
+class HandGroupPlan:
+    """A hand group prepared for the solver: its (at most two) strokes, the notes of
+    each, bounces (index of the stroke they ride on, notes) and notes beyond two hands."""
+
+    group: drums_mod.HandGroup
+    kept: list[list[DrumHeld]]
+    bounces: list[tuple[int, list[DrumHeld]]]
+    extra: list[DrumHeld]
+
+
+def hand_group(group: list[DrumHeld], t0: float) -> HandGroupPlan:
+    """The strokes of a group: notes of one piece within SAME_STROKE_S are one stroke.
+
+    The two most important strokes (velocity-weighed priority, then the earlier)
+    are planned; a further stroke on a piece already planned is a bounce of the
+    nearest planned stroke there (a buzz or a drag's second note, same hand); a
+    third distinct piece within the window is more than two hands can strike.
+    """
+    if not group:
+        return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
+    clusters: list[list[DrumHeld]] = []
+    for r in sorted(group, key=lambda r: (r.note.time_s, r.seq)):
+        same = next(
+            (
+                c
+                for c in clusters
+                if c[0].drum.piece == r.drum.piece
+                and r.note.time_s - c[0].note.time_s <= SAME_STROKE_S
+            ),
+            None,
+        )
+        if same is None:
+            clusters.append([r])
+        else:
+            same.append(r)
+
+    def rank(c: list[DrumHeld]) -> tuple[int, float, int]:
+        prio = min(velocity_priority(r.drum.priority, r.note.velocity) for r in c)
+        return (prio, c[0].note.time_s, c[0].seq)
+
+    ranked = sorted(clusters, key=rank)
+    kept = ranked[:2]
+    bounces: list[tuple[int, list[DrumHeld]]] = []
+    extra: list[DrumHeld] = []
+    for c in ranked[2:]:
+        piece = c[0].drum.piece
+        near = [
+            (abs(k[0].note.time_s - c[0].note.time_s), i)
+            for i, k in enumerate(kept)
+            if k[0].drum.piece == piece
+        ]
+        if near:
+            bounces.append((min(near)[1], c))
+        else:
+            extra.extend(c)
+    strokes = tuple(
+        drums_mod.Stroke(c[0].drum.piece, rank(c)[0], c[0].note.time_s - t0) for c in kept
+    )
+    return HandGroupPlan(drums_mod.HandGroup(t0, strokes), kept, bounces, extra)
+
+
+class HandsChain(DrumChain):
+    """The drummer's two hands (see the module docstring); ``foot`` is the left
+    foot's chain, which takes the hi-hat notes the hands cannot."""
+
+    def __init__(self, ctx: ChainContext, foot: FootChain) -> None:
+        super().__init__(ctx)
+        self.foot = foot
+        self.state: drums_mod.HandState = drums_mod.START
+        self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
+
+    def kind(self, drum: DrumNote) -> str:
+        return drum.piece
+
+    def forget_plan(self) -> None:
+        self.plan.forget()
+
+    def _rebounds(self) -> set[int]:
+        """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
+        note on the same piece, fixed or pending, within its ``min_interval_s`` (a
+        buzz: soft rebounds of one pressed stroke)."""
+        strokes: dict[str, list[float]] = {}
+        for ft, p in self.fixed:
+            if p.piece is not None:
+                strokes.setdefault(p.piece, []).append(ft)
+        for r in self.pending:
+            strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
+        for r in self.pending:
+            if r.rebound is not None:
+                continue
+            r.rebound = False
+            if r.note.velocity >= BUZZ_VELOCITY:
+                continue
+            if r.drum.piece not in BUZZ_PIECES:  # a crash swings away: no rebound
+                continue
+            t = r.note.time_s
+            reach = self.ctx.config.timing.get(r.drum.piece).min_interval_s
+            if r.note.velocity >= REBOUND_VELOCITY:
+                reach = max(reach, BUZZ_S)
+            r.rebound = any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ()))
+        return {r.seq for r in self.pending if r.rebound}
+
+    def _decide_foot(self, group: list[DrumHeld], rebounds: set[int]) -> None:
+        """Three or more hand pieces at once, one the hi-hat: the left foot takes the
+        hi-hat (a chick) if it is free, and the hands keep the rest."""
+        undecided = [r for r in group if r.to_foot is None]
+        if not undecided:
+            return
+        pieces = {r.drum.piece for r in group if r.seq not in rebounds}
+        crowded = len(pieces) >= 3 and "hihat" in pieces
+        for r in undecided:
+            r.to_foot = (
+                crowded
+                and r.seq not in rebounds
+                and r.drum.piece == "hihat"
+                and self.foot.can_chick(r.note.time_s)
+            )
+
+    def fix_groups(self, groups: list[list[DrumHeld]], n_groups: int) -> None:
+        rebounds = self._rebounds()
+        for g in groups:
+            self._decide_foot(g, rebounds)
+        aside = rebounds | {r.seq for r in self.pending if r.to_foot}
+
+        def prepare(g: list[DrumHeld]) -> HandGroupPlan:
+            return hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
+
+        def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
+            sol = drums_mod.solve(
+                self.ctx.config.costs,
+                self.ctx.config.timing,
+                self.state,
+                [prepare(g).group for g in win],
+                beam=self.ctx.bounds.beam,
+            )
+            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+
+        for gi in range(n_groups):
+            hp = prepare(groups[gi])
+            assignment, stroke_costs, state = self.plan.step(groups, gi, solve)
+            self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
+            self.state = state
+
+    def _fix_group(
+        self,
+        group: list[DrumHeld],
+        hp: HandGroupPlan,
+        assignment: drums_mod.Assignment,
+        stroke_costs: tuple[float, ...],
+        rebounds: set[int],
+    ) -> None:
+        """Emit one group's notes by the solver's ``assignment`` of its strokes."""
+        for r in hp.extra:
+            if not self.foot.chick(r):
+                self.drop(r, "too_many_hands")
+        # three or more pieces at once: whatever else gives way, gives way to that
+        slow: DropReason = "too_many_hands" if hp.extra else "too_fast"
+        late_rebounds = [r for r in group if r.seq in rebounds]
+        for r in group:
+            if r.to_foot and not self.foot.chick(r):
+                self.drop(r, "too_many_hands")
+        for si, stroke in enumerate(hp.group.strokes):
+            recs = hp.kept[si]
+            hand = assignment[si]
+            bounces = [r for k, c in hp.bounces if k == si for r in c]
+            other = 1 - si
+            if (
+                hand is None
+                and len(hp.group.strokes) == 2
+                and hp.group.strokes[other].piece == stroke.piece
+                and assignment[other] is not None
+            ):
+                # no second hand for it, but the first is on the same piece: a
+                # rebound of that stroke (a drag, a buzz, a pad's double trigger)
+                hand = assignment[other]
+                assert hand is not None
+                for r in recs + bounces:
+                    self.emit_bounce(r, stroke.piece, hand)
+                continue
+            if hand is None:
+                for r in recs + bounces:
+                    if not self.foot.chick(r):
+                        self.drop(r, slow)
+                continue
+            now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
+            self.emit_stroke(now, stroke.piece, hand, stroke_costs[si])
+            for r in recs[len(now) :] + bounces:
+                self.emit_bounce(r, stroke.piece, hand)
+        for r in late_rebounds:
+            self._emit_rebound(r)
+
+    def _emit_rebound(self, rec: DrumHeld) -> None:
+        """``rec`` rides on the latest stroke before it on its piece (see
+        :meth:`_rebounds`); dropped if that stroke was not played."""
+        t = rec.note.time_s
+        by = next(
+            (p for ft, p in reversed(self.fixed) if p.piece == rec.drum.piece and ft < t),
+            None,
+        )
+        if by is None:
+            self.drop(rec, "too_fast")
+        else:
+            self.emit_bounce(rec, rec.drum.piece, by.limb)
+
+    def place_stroke(self, rec: DrumHeld, min_interval_s: float) -> None:
+        """The free hand cheapest by the table from the fixed motion before ``rec``
+        (none after a rest), or dropped (``no_free_limb``)."""
+        t = rec.note.time_s
+        costs = self.ctx.config.costs
+        before = [(ft, p) for ft, p in self.fixed if ft < t - GROUP_EPS_S]
+        row = costs.none_row
+        if before and t - before[-1][0] < self.ctx.config.timing.rest_s:
+            row = costs.motions.index(before[-1][1].motion.name)
+        choices = [
+            (costs.table[row][costs.index(rec.drum.piece, h)], h)
+            for h in (drums_mod.LEFT, drums_mod.RIGHT)
+            if self.limb_free(h, t, min_interval_s)
+        ]
+        if not choices:
+            self.drop(rec, "no_free_limb")
+            return
+        cost, hand = min(choices)
+        self.emit_stroke([rec], rec.drum.piece, hand, cost)

@@ -62,7 +62,12 @@ def test_chick_takes_a_hihat_note_when_the_foot_is_free_or_already_there() -> No
     assert foot.can_chick(2.0)
     assert foot.chick(rec)
     p = foot.ctx.ledger.outbox[-1]
-    assert (p.limb, p.piece, p.motion.name, p.impact) == ("left_foot", "hihat", "hihat_left_foot", 2.0)
+    assert (p.limb, p.piece, p.motion.name, p.impact) == (
+        "left_foot",
+        "hihat",
+        "hihat_left_foot",
+        2.0,
+    )
     assert foot.state == 2.0 and foot.ctx.ledger.counts["foot_chick"] == 1
     assert foot.can_chick(1.01)  # with the pending pedal stroke: rides on it
     assert not foot.can_chick(1.05)  # 50 ms after it: sooner than the pedal can

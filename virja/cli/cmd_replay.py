@@ -23,18 +23,22 @@ import argparse
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from virja.cli.common import (
     SAMPLE_CHOICES,
     add_routing_arguments,
     finite_float,
-    make_router,
     open_plan_log,
+    performance_settings,
 )
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
+
+if TYPE_CHECKING:
+    from virja.input import PerformanceInput
+    from virja.pipeline import PerformanceSettings
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -76,46 +80,38 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from virja.cli.common import routing_config
     from virja.input import pcap_input
 
     if args.port is not None and not 1 <= args.port <= 65535:
         raise ConfigError(f"--port must be 1-65535, got {args.port}")
     if args.dancer and not args.out:
         raise ConfigError("--dancer draws into a rendering: give --out too")
+    settings = performance_settings(args)
+    request = None
     if args.out:
-        from virja.cli.cmd_render import check_outputs
-        from virja.render.offline import OutputSpec, parse_size
+        from virja.cli.cmd_render import check_outputs, render_request
 
-        args.at = args.start = args.end = None
-        args.bvh = None
-        size, out = parse_size(args.size), OutputSpec.from_path(args.out)
-        check_outputs(args, out)  # before the work
-    src = pcap_input(Path(args.input), routing_config(args), port=args.port, key_file=args.key_file)
+        # the whole recording: replay has no --at, --start, --end or --bvh
+        request = render_request(args, settings, span=False)
+        check_outputs(request)  # before the work
+    src = pcap_input(Path(args.input), settings.routing, port=args.port, key_file=args.key_file)
     for line in src.report:
         print(line)
     if not src.schedule:
         raise InputFileError(args.input, "the recording holds no valid RMCP events")
-    if args.out:
+    if request is not None:
         from virja.cli.cmd_render import render_input
 
-        return render_input(src, args, size, out)
-    return play(src, args)
+        return render_input(src, request)
+    return play(src, settings, args)
 
 
-def play(src: object, args: argparse.Namespace) -> int:
-    from virja.cli.rtp_midi import plan_config
-    from virja.input import PerformanceInput
-    from virja.plan.planner import OnlinePlanner
-    from virja.session import Performance, run_schedule
+def play(src: PerformanceInput, settings: PerformanceSettings, args: argparse.Namespace) -> int:
+    from virja.pipeline import build_performance
+    from virja.session import run_schedule
 
-    assert isinstance(src, PerformanceInput)
     plan_log = open_plan_log(args.plan_log)
-    perf = Performance(
-        router=make_router(args),
-        planner=OnlinePlanner(plan_config(args.config, immediate=src.immediate)),
-        plan_log=plan_log,
-    )
+    perf = build_performance(settings, src, plan_log=plan_log)
     try:
         if args.headless and not args.web:
             run_schedule(perf, src.schedule)

@@ -30,7 +30,12 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from virja.cli import rtp_midi
-from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
+from virja.cli.common import (
+    add_routing_arguments,
+    finite_float,
+    open_plan_log,
+    performance_settings,
+)
 from virja.cli.web_option import add_web_arguments, open_web
 from virja.config import load_config
 from virja.errors import ConfigError, NotAvailableError
@@ -293,14 +298,13 @@ async def serve(args: argparse.Namespace) -> int:
     from virja.live.sinks import Fanout
     from virja.live.timer import DeadlineTimer, wake_in
     from virja.live.viewer import Viewer, ViewerSpec
-    from virja.plan.planner import OnlinePlanner
+    from virja.pipeline import build_performance
     from virja.render.offline import parse_size
     from virja.rmcp.pcap import PcapWriter
     from virja.rmcp.receiver import Receiver, ReceiverConfig
     from virja.rmcp.signing import load_key
     from virja.rmcp.stamped import open_stamped_listener
     from virja.rmcp.transport import ClockClient, RmcpProtocol, parse_hostport
-    from virja.session import Performance
 
     load_config(args.config)  # fail early on a bad file
     if args.duration is not None and args.duration <= 0:
@@ -318,10 +322,8 @@ async def serve(args: argparse.Namespace) -> int:
     if clock_server is not None:
         _resolve_or_fail(clock_server, "--clock-server")
     # bind first: a port in use must not cost the user an existing plan log or recording
-    perf = Performance(
-        router=make_router(args),
-        planner=OnlinePlanner(rtp_midi.plan_config(args.config, immediate=bool(args.rtp_midi))),
-    )
+    # RTP-MIDI notes are played at once: the shortest strokes (docs/rtp-midi.md)
+    perf = build_performance(performance_settings(args, immediate=bool(args.rtp_midi)))
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
     if not 1 <= args.fps <= 1000:
         raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")

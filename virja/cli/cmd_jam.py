@@ -28,7 +28,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 from virja.cli import rtp_midi
 from virja.cli.common import finite_float
-from virja.cli.web_option import add_web_arguments, open_web
+from virja.cli.web_option import add_web_arguments, web_settings
 from virja.config import section
 from virja.errors import ConfigError, InputFileError
 
@@ -175,6 +175,8 @@ def run(args: argparse.Namespace) -> int:
     from virja.jam.keyboard import routing_table
     from virja.jam.live import KeyboardJam, RmcpStream
     from virja.jam.ports import MidiInput, MidiOutput, probe_api
+    from virja.live.outputs import LiveOutputs, LiveSettings
+    from virja.live.viewer import ViewerSpec
     from virja.pipeline import build_performance
     from virja.render.offline import parse_size
     from virja.rmcp.transport import parse_hostport
@@ -197,18 +199,11 @@ def run(args: argparse.Namespace) -> int:
             animate=bool(args.web),  # poses here only for the browser; the window animates itself
             plan_log=log_fh,
         )
-        view = None
-        if not args.headless:  # the window draws in its own process (see virja.live.viewer)
-            from virja.live.sinks import Fanout
-            from virja.live.viewer import Viewer, ViewerSpec
-
-            spec = ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
-            view = Viewer(spec, clock.now_s)
-            perf.animator = Fanout([s for s in (perf.animator, view) if s is not None])
-            stack.callback(view.close)
-        web = open_web(args, perf, clock.now_s)
-        if web is not None:
-            stack.callback(web.close)
+        # the window draws in its own process (see virja.live.viewer)
+        window = None if args.headless else ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
+        outputs = LiveOutputs.open(perf, LiveSettings(window, web_settings(args)), clock.now_s)
+        stack.callback(outputs.close)
+        view, web = outputs.viewer, outputs.web
         thru = None
         if opts.thru is not None:
             thru = MidiOutput(api, opts.thru, clock.now_s)

@@ -89,9 +89,10 @@ def measure(notes: int, gap_s: float) -> list[float]:
 
 def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[float]:
     """Key-to-impact-drawn latencies (s) through the jam path and the renderer."""
-    from virja.cli.cmd_jam import build_performance
+    from virja.cli.cmd_jam import jam_settings
     from virja.jam.keyboard import KeyboardLayout
     from virja.jam.live import KeyboardJam
+    from virja.pipeline import build_performance
     from virja.render.camera import PRESETS
     from virja.render.hosts import OffscreenTarget, create_headless_context
     from virja.render.renderer import Renderer
@@ -99,7 +100,7 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[floa
 
     clock = time.perf_counter
     jam = KeyboardJam(KeyboardLayout(), delay_s=0.0, thru=None, stream=None)
-    perf = build_performance({}, plan_log=None, animate=True, delay_s=0.0)
+    perf = build_performance(jam_settings({}, delay_s=0.0), animate=True)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     target = OffscreenTarget(ctx, size, samples=1)

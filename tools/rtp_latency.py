@@ -52,26 +52,20 @@ def _free_even_port() -> int:
 async def measure(
     notes: int, gap_s: float, size: tuple[int, int], draw: bool = True
 ) -> tuple[list[float], list[float], list[float]]:
-    from virja.cli.rtp_midi import plan_config
     from virja.clock import SessionClock
-    from virja.motion.band import BandAnimator
-    from virja.plan.planner import OnlinePlanner
+    from virja.pipeline import PerformanceSettings, build_performance
     from virja.render.camera import PRESETS
     from virja.render.hosts import OffscreenTarget, create_headless_context
     from virja.render.renderer import Renderer
     from virja.render.scene import band_scene, static_scene
-    from virja.routing import Router, RoutingConfig
+    from virja.routing import RoutingConfig
     from virja.rtpmidi.recording import to_received
     from virja.rtpmidi.transport import Listener
-    from virja.session import Performance
 
     clock = SessionClock()
-    router = Router(RoutingConfig.from_dict({"channels": {"1": "bass"}}, "[routing]"))
-    perf = Performance(
-        router=router,
-        planner=OnlinePlanner(plan_config(None, immediate=True)),
-        animator=BandAnimator(),
-    )
+    routing = RoutingConfig.from_dict({"channels": {"1": "bass"}}, "[routing]")
+    # RTP-MIDI notes are played at once: the shortest strokes, as `serve --rtp-midi`
+    perf = build_performance(PerformanceSettings(routing=routing, immediate=True), animate=True)
     arrivals: list[float] = []
     pending: list[tuple[float, float]] = []  # (impact, note time) of motions not drawn yet
 

@@ -182,7 +182,7 @@ def test_an_interrupted_video_is_removed_and_said(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     from virja.render.camera import PRESETS
-    from virja.render.offline import OutputSpec, render_frames
+    from virja.render.offline import OutputSpec, RenderSettings, render_frames
     from virja.render.scene import static_scene
 
     video = tmp_path / "x.mp4"
@@ -195,11 +195,13 @@ def test_an_interrupted_video_is_removed_and_said(
         render_frames(
             [i / 30 for i in range(30)],
             lambda t: [static_scene()],
-            fps=30,
-            size=(64, 36),
-            out=OutputSpec("video", video),
-            camera=PRESETS["front"],
-            progress=stop_at_three,
+            RenderSettings(
+                OutputSpec("video", video),
+                size=(64, 36),
+                fps=30,
+                camera=PRESETS["front"],
+                progress=stop_at_three,
+            ),
         )
     assert not video.exists()
     assert "interrupted: the unfinished video" in caplog.text

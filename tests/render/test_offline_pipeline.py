@@ -10,7 +10,7 @@ import numpy as np
 from virja.render.camera import PRESETS
 from virja.render.images import decode_png_rgb
 from virja.render.meshes import sphere_transforms
-from virja.render.offline import OutputSpec, render_frames
+from virja.render.offline import OutputSpec, RenderSettings, render_frames
 from virja.render.renderer import DrawList
 from virja.render.scene import static_scene
 
@@ -33,12 +33,12 @@ def test_each_frame_is_its_own_scene(tmp_path: Path) -> None:
         return scene_at(t)
 
     common = {"fps": 2.5, "size": (96, 54), "camera": PRESETS["front"]}
-    render_frames(times, logged, out=OutputSpec("folder", tmp_path / "all"), **common)  # type: ignore[arg-type]
+    render_frames(times, logged, RenderSettings(OutputSpec("folder", tmp_path / "all"), **common))  # type: ignore[arg-type]
     assert calls == times  # every scene built once, in order
     frames = [decode_png_rgb(p.read_bytes()) for p in sorted((tmp_path / "all").glob("*.png"))]
     assert len(frames) == len(times)
     for i, t in enumerate(times):
         one = tmp_path / f"one_{i}.png"
-        render_frames([t], scene_at, out=OutputSpec("png", one), **common)  # type: ignore[arg-type]
+        render_frames([t], scene_at, RenderSettings(OutputSpec("png", one), **common))  # type: ignore[arg-type]
         assert np.array_equal(frames[i], decode_png_rgb(one.read_bytes())), f"frame {i}"
     assert not np.array_equal(frames[0], frames[1])  # the ball moved: a swap would show

@@ -9,7 +9,7 @@ from virja.events import Beat, ControlChange, Event, NoteOff, NoteOn, ProgramCha
 from virja.rmcp.bodies import BeatBody, MidiBody
 from virja.rmcp.receiver import Received, Receiver, ReceiverConfig
 from virja.rmcp.sender import SendOptions, beats_of, schedule_pass
-from virja.rmcp.streamer import stream
+from virja.rmcp.streamer import SendSettings, stream
 from virja.rmcp.transport import RmcpProtocol, open_listener, parse_hostport
 from virja.tempo import TempoMap
 
@@ -114,16 +114,13 @@ def test_loopback_sender_to_transport_to_events() -> None:
         events: list[Event] = [NoteOn(0.0, 9, 36, 100), NoteOff(0.05, 9, 36, 0)]
         try:
             stats = await stream(
-                to=("127.0.0.1", port),
+                SendSettings(("127.0.0.1", port), SendOptions(), start_in_s=0.2, max_passes=1),
                 events=events,
                 tempo=TempoMap([(0.0, 0.05)]),
                 beats=[Beat(0.0, 0, 1, 4, 2, 50_000)],
                 duration_s=0.1,
-                options=SendOptions(),
                 route_factory=lambda: route,
                 clock=clock,
-                start_in_s=0.2,
-                max_passes=1,
             )
             assert stats.datagrams == 3
             for _ in range(100):  # bounded wait for the datagrams to arrive

@@ -2,7 +2,7 @@
 
 :func:`run_job` takes the input's bytes (so a worker on another machine needs
 no shared filesystem), plans and animates it through the same pipeline as a
-performance (``virja.input`` reveal schedule -> ``session.Performance``), and
+performance (``virja.input`` reveal schedule -> ``pipeline.build_performance``), and
 returns every output as bytes.  It never raises: a failure is a result with
 status ``error`` and a one-line message naming the input.
 """
@@ -20,9 +20,10 @@ from virja.batch.jobs import Job, OutputKind
 from virja.batch.manifest import JobResult, Status
 from virja.errors import VirjaError
 from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
+from virja.pipeline import PerformanceSettings, build_performance
 from virja.plan.config import PlanConfig
-from virja.routing import Router, RoutingConfig
-from virja.session import Performance, RevealFeeder, run_schedule
+from virja.routing import RoutingConfig
+from virja.session import RevealFeeder, run_schedule
 
 
 @dataclass(frozen=True)
@@ -37,33 +38,14 @@ class BatchSettings:
     size: tuple[int, int] = (1280, 720)
     soundfont: str | None = None
 
-
-def _performance(src: PerformanceInput, settings: BatchSettings, *, animate: bool) -> Performance:
-    from virja.plan.immediate import immediate_strokes
-    from virja.plan.planner import OnlinePlanner
-
-    router = (
-        Router.for_session(src.midi, settings.routing)
-        if src.midi is not None
-        else Router(settings.routing)
-    )
-    animator = None
-    if animate:
-        from virja.motion.band import BandAnimator
-
-        animator = BandAnimator()
-    return Performance(
-        router=router,
-        # a recording's RTP-MIDI notes were played at once, as live (docs/rtp-midi.md)
-        planner=OnlinePlanner(
-            immediate_strokes(settings.plan) if src.immediate else settings.plan, tempo=src.tempo
-        ),
-        animator=animator,
-    )
+    @property
+    def performance(self) -> PerformanceSettings:
+        """What :func:`virja.pipeline.build_performance` builds each job's performance from."""
+        return PerformanceSettings(self.plan, self.routing)
 
 
 def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
-    perf = _performance(src, settings, animate=False)
+    perf = build_performance(settings.performance, src)
     planned = run_schedule(perf, src.schedule)
     path = out / "plan.jsonl"
     path.write_text("".join(json.dumps(p.to_json()) + "\n" for p in planned), encoding="utf-8")
@@ -71,28 +53,23 @@ def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> lis
 
 
 def _make_mp4(src: PerformanceInput, out: Path, settings: BatchSettings) -> list[Path]:
-    from virja.render.camera import PRESETS
-    from virja.render.offline import OutputSpec, render_offline
+    from virja.render.offline import OutputSpec, RenderSettings, render_offline
     from virja.render.video import make_audio_track
 
-    perf = _performance(src, settings, animate=True)
+    perf = build_performance(settings.performance, src, animate=True)
     t0, t1 = src.default_span()
     video = out / "take.mp4"
     audio, _why_not = make_audio_track(
         src.sound_events, src.sound_origin_s, out, settings.soundfont
     )
-    render_offline(
-        perf,
-        RevealFeeder(src.schedule),
-        t0_s=t0,
-        t1_s=t1,
-        fps=settings.fps,
+    frames = RenderSettings(
+        OutputSpec("video", video),
         size=settings.size,
-        out=OutputSpec("video", video),
-        camera=PRESETS["front"],
+        fps=settings.fps,
         audio=audio,
         audio_offset_s=src.sound_origin_s - t0,
     )
+    render_offline(perf, RevealFeeder(src.schedule), (t0, t1), frames)
     return [video]
 
 

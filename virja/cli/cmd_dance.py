@@ -60,7 +60,7 @@ def render(args: argparse.Namespace, bvh: object, music_s: float) -> None:
     from virja.motion.bvh import Bvh
     from virja.render.camera import PRESETS
     from virja.render.dancer import render_dancer_alone
-    from virja.render.offline import OutputSpec, parse_size
+    from virja.render.offline import OutputSpec, RenderSettings, parse_size
 
     assert isinstance(bvh, Bvh)
     if args.camera not in PRESETS:
@@ -69,14 +69,13 @@ def render(args: argparse.Namespace, bvh: object, music_s: float) -> None:
         raise ConfigError(f"--fps must be in (0, 240], got {args.fps}")
     out = OutputSpec.from_path(args.render)
     track = DancerTrack(bvh, t0_s=0.0)
-    result = render_dancer_alone(
-        track.pose,
-        t0_s=0.0,
-        t1_s=max(music_s, (bvh.n_frames - 1) * bvh.frame_time_s),
-        fps=args.fps,
+    settings = RenderSettings(
+        out,
         size=parse_size(args.size),
-        out=out,
+        fps=args.fps,
         camera=PRESETS[args.camera],
         audio=Path(args.music) if out.kind == "video" else None,
     )
+    t1 = max(music_s, (bvh.n_frames - 1) * bvh.frame_time_s)
+    result = render_dancer_alone(track.pose, (0.0, t1), settings)
     print(f"wrote {result.frames} frames to {out.path} in {result.seconds:.1f} s")

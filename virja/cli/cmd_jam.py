@@ -28,7 +28,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 from virja.cli import rtp_midi
 from virja.cli.common import finite_float
-from virja.cli.web_option import add_web_arguments, open_web
+from virja.cli.web_option import add_web_arguments, web_settings
 from virja.config import section
 from virja.errors import ConfigError, InputFileError
 
@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from virja.jam.live import KeyboardJam
     from virja.jam.options import JamOptions
     from virja.jam.ports import MidiInput, MidiOutput
+    from virja.pipeline import PerformanceSettings
     from virja.session import Performance
 
 
@@ -147,47 +148,25 @@ def _plan_log(path: str | None) -> Iterator[IO[str] | None]:
         yield fh
 
 
-def jam_plan_config(config_path: str | None, delay_s: float) -> Any:
-    """The scheduler's tables for a jam.
+def jam_settings(
+    doc: dict[str, Any], delay_s: float = 0.0, config_path: str | None = None
+) -> PerformanceSettings:
+    """What a jam's performance is built from (:func:`virja.pipeline.build_performance`).
 
     Without --delay-ms a key's note is already due when it arrives, so every
     motion is compressed; its shortest stroke is cut to IMMEDIATE_STROKE_S so the
     impact is drawn within a frame of the key (:mod:`virja.plan.immediate`).  With a
     delay at least as long as the longest anticipation the tables are used as they are.
-    """
-    from virja.plan.config import load_plan_config
-    from virja.plan.immediate import immediate_strokes
-
-    config = load_plan_config(config_path)
-    return config if delay_s > 0 else immediate_strokes(config)
-
-
-def build_performance(
-    doc: dict[str, Any],
-    *,
-    plan_log: IO[str] | None,
-    animate: bool,
-    delay_s: float = 0.0,
-    config_path: str | None = None,
-) -> Performance:
-    """The one place where the jam meets the band: router + planner (+ animator).
-
     Events reach the performance already routed by the keyboard split
     (``feed_routed``); its router is there for the Performance's contract only.
     """
-    from virja.plan.planner import OnlinePlanner
-    from virja.routing import Router, RoutingConfig
-    from virja.session import Performance
+    from virja.pipeline import PerformanceSettings
+    from virja.plan.config import load_plan_config
+    from virja.routing import RoutingConfig
 
     where = f"{config_path} [routing]" if config_path else "[routing]"
-    router = Router(RoutingConfig.from_dict(section(doc, "routing"), where))
-    animator = None
-    if animate:
-        from virja.motion.band import BandAnimator
-
-        animator = BandAnimator()
-    planner = OnlinePlanner(jam_plan_config(config_path, delay_s))
-    return Performance(router=router, planner=planner, animator=animator, plan_log=plan_log)
+    routing = RoutingConfig.from_dict(section(doc, "routing"), where)
+    return PerformanceSettings(load_plan_config(config_path), routing, immediate=delay_s <= 0)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -196,6 +175,9 @@ def run(args: argparse.Namespace) -> int:
     from virja.jam.keyboard import routing_table
     from virja.jam.live import KeyboardJam, RmcpStream
     from virja.jam.ports import MidiInput, MidiOutput, probe_api
+    from virja.live.outputs import LiveOutputs, LiveSettings
+    from virja.live.viewer import ViewerSpec
+    from virja.pipeline import build_performance
     from virja.render.offline import parse_size
     from virja.rmcp.transport import parse_hostport
 
@@ -213,24 +195,15 @@ def run(args: argparse.Namespace) -> int:
     clock = SessionClock()
     with contextlib.ExitStack() as stack, _plan_log(args.plan_log) as log_fh:
         perf = build_performance(
-            doc,
-            plan_log=log_fh,
+            jam_settings(doc, opts.delay_s, args.config),
             animate=bool(args.web),  # poses here only for the browser; the window animates itself
-            delay_s=opts.delay_s,
-            config_path=args.config,
+            plan_log=log_fh,
         )
-        view = None
-        if not args.headless:  # the window draws in its own process (see virja.live.viewer)
-            from virja.live.sinks import Fanout
-            from virja.live.viewer import Viewer, ViewerSpec
-
-            spec = ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
-            view = Viewer(spec, clock.now_s)
-            perf.animator = Fanout([s for s in (perf.animator, view) if s is not None])
-            stack.callback(view.close)
-        web = open_web(args, perf, clock.now_s)
-        if web is not None:
-            stack.callback(web.close)
+        # the window draws in its own process (see virja.live.viewer)
+        window = None if args.headless else ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
+        outputs = LiveOutputs.open(perf, LiveSettings(window, web_settings(args)), clock.now_s)
+        stack.callback(outputs.close)
+        view, web = outputs.viewer, outputs.web
         thru = None
         if opts.thru is not None:
             thru = MidiOutput(api, opts.thru, clock.now_s)

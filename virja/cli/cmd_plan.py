@@ -20,7 +20,12 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from virja.cli.common import add_routing_arguments, finite_float, routing_config
+from virja.cli.common import (
+    add_routing_arguments,
+    finite_float,
+    performance_settings,
+    routing_config,
+)
 from virja.errors import ConfigError
 from virja.events import NoteOn
 from virja.input import PerformanceInput, nothing_for_the_band
@@ -49,21 +54,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _plan_midi(
     path: Path, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
+    """A file's notes, each revealed --lookahead-beats ahead, planned as the daemon would
+    (:func:`virja.plan.plan_notes_with_report`: the notes alone, the file's tempo map)."""
     from virja.midifile import read_midi
-    from virja.plan import load_plan_config, plan_notes_with_report
+    from virja.plan import plan_notes_with_report
     from virja.routing import Router, route_all
 
     session = read_midi(path)
-    router = Router.for_session(
-        session,
-        routing_config(args, doc),
-    )
+    settings = performance_settings(args, doc)
+    router = Router.for_session(session, settings.routing)
     notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
     return plan_notes_with_report(
         notes,
         session.tempo_map,
         lookahead_beats=args.lookahead_beats,
-        config=load_plan_config(args.config),
+        config=settings.plan,
     )
 
 
@@ -71,15 +76,11 @@ def _plan_pcap(
     src: PerformanceInput, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
     """A recording through the live receiver and planner on its recorded clock."""
-    from virja.cli.rtp_midi import plan_config
-    from virja.plan import OnlinePlanner
-    from virja.routing import Router
-    from virja.session import Performance, run_schedule
+    from virja.pipeline import build_performance
+    from virja.session import run_schedule
 
-    routing = routing_config(args, doc)
-    planner = OnlinePlanner(plan_config(args.config, immediate=src.immediate))
-    perf = Performance(router=Router(routing), planner=planner)
-    return run_schedule(perf, src.schedule), planner.report
+    perf = build_performance(performance_settings(args, doc), src)
+    return run_schedule(perf, src.schedule), perf.planner.report
 
 
 def _input(path: Path, args: argparse.Namespace, doc: dict[str, Any]) -> PerformanceInput:

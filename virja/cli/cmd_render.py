@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -27,17 +28,19 @@ from virja.cli.common import (
     add_routing_arguments,
     check_writable,
     finite_float,
-    make_router,
     open_plan_log,
-    routing_config,
+    performance_settings,
 )
 from virja.errors import ConfigError
 from virja.render.camera import PRESETS
 
 if TYPE_CHECKING:
     from virja.dance.stage import DancerTrack
+    from virja.input import PerformanceInput
+    from virja.pipeline import PerformanceSettings
     from virja.render.camera import Camera
     from virja.render.director import FollowCamera
+    from virja.render.offline import RenderSettings
     from virja.render.renderer import DrawList
 
 log = logging.getLogger(__name__)
@@ -132,6 +135,61 @@ def add_dancer_argument(p: argparse.ArgumentParser) -> None:
     )
 
 
+@dataclass(frozen=True)
+class RenderRequest:
+    """What `render` and `replay --out` take from their options, parsed once: the
+    performance's settings, the frames' settings (camera still by name: "follow" is
+    planned from the input), the span (``at``/``start``/``end``: seconds from the
+    input's start) and the other files to write."""
+
+    performance: PerformanceSettings
+    frames: RenderSettings
+    camera: str = "front"
+    audio: bool = True
+    soundfont: str | None = None
+    at: float | None = None
+    start: float | None = None
+    end: float | None = None
+    plan_log: str | None = None
+    bvh: str | None = None
+    dancer: str | None = None
+
+
+def render_request(
+    args: argparse.Namespace, performance: PerformanceSettings, *, span: bool = True
+) -> RenderRequest:
+    """The request of `render` (``span``: it has --at, --start, --end and --bvh) or of
+    `replay --out`; the frame size and the output kind checked."""
+    from virja.render.offline import OutputSpec, RenderSettings, parse_size
+
+    size = parse_size(args.size)
+    out = OutputSpec.from_path(args.out)
+    at = args.at if span else None
+    if at is not None and out.kind != "png":
+        raise ConfigError("--at renders one frame: give --out NAME.png")
+    frames = RenderSettings(
+        out,
+        size=size,
+        fps=args.fps,
+        samples=args.samples,
+        hud=bool(getattr(args, "hud", False)),
+        progress=ProgressBar("rendering") if out.kind != "png" or at is None else None,
+    )
+    return RenderRequest(
+        performance=performance,
+        frames=frames,
+        camera=args.camera,
+        audio=not args.no_audio,
+        soundfont=args.soundfont,
+        at=at,
+        start=args.start if span else None,
+        end=args.end if span else None,
+        plan_log=args.plan_log,
+        bvh=args.bvh if span else None,
+        dancer=getattr(args, "dancer", None),
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     from virja.input import load_performance_input, nothing_for_the_band
 
@@ -139,128 +197,111 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--fps must be in (0, 240], got {args.fps}")
     if args.lookahead_beats < 0:
         raise ConfigError("--lookahead-beats must be >= 0")
-    from virja.render.offline import OutputSpec, parse_size
-
-    size = parse_size(args.size)
-    out = OutputSpec.from_path(args.out)
-    if args.at is not None and out.kind != "png":
-        raise ConfigError("--at renders one frame: give --out NAME.png")
-    check_outputs(args, out)
+    request = render_request(args, performance_settings(args))
+    check_outputs(request)
     src = load_performance_input(
-        Path(args.input), routing_config(args), lookahead_beats=args.lookahead_beats
+        Path(args.input), request.performance.routing, lookahead_beats=args.lookahead_beats
     )
     for line in src.report:
         print(line)
     if src.note_count == 0:
         raise nothing_for_the_band(Path(args.input), src.report)
-    return render_input(src, args, size, out)
+    return render_input(src, request)
 
 
-def check_outputs(args: argparse.Namespace, out: object) -> None:
+def check_outputs(request: RenderRequest) -> None:
     """Every file the render will write is writable, and the soundfont is one: checked
     before the (long) work, each a one-line error.  Shared by `render` and `replay --out`."""
     from virja.motion.export import bvh_paths
-    from virja.render.offline import OutputSpec
     from virja.render.video import check_soundfont
 
-    assert isinstance(out, OutputSpec)
-    one_file = out.kind == "video" or (out.kind == "png" and args.at is not None)
+    out = request.frames.out
+    one_file = out.kind == "video" or (out.kind == "png" and request.at is not None)
     check_writable(out.path if one_file else out.frame_path(0), "--out")
-    if getattr(args, "bvh", None):
-        for path in bvh_paths(Path(args.bvh)):
+    if request.bvh:
+        for path in bvh_paths(Path(request.bvh)):
             check_writable(path, "--bvh")
-    if getattr(args, "soundfont", None) and out.kind == "video" and not args.no_audio:
-        check_soundfont(Path(args.soundfont), "--soundfont")
+    if request.soundfont and out.kind == "video" and request.audio:
+        check_soundfont(Path(request.soundfont), "--soundfont")
 
 
-def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], out: object) -> int:
-    """Shared by `render` and `replay --out`: plan, animate, draw, encode."""
-    from virja.cli.rtp_midi import plan_config
-    from virja.input import PerformanceInput
-    from virja.motion.band import BandAnimator
-    from virja.plan.planner import OnlinePlanner
-    from virja.render.offline import OutputSpec, render_offline
-    from virja.render.video import make_audio_track, temp_workdir
-    from virja.session import Performance, RevealFeeder
-
-    assert isinstance(src, PerformanceInput) and isinstance(out, OutputSpec)
-    plan_log = open_plan_log(args.plan_log)
-    planner = OnlinePlanner(plan_config(args.config, immediate=src.immediate), tempo=src.tempo)
-    animator = BandAnimator()
-    perf = Performance(
-        router=make_router(args, src.midi), planner=planner, animator=animator, plan_log=plan_log
-    )
-    feeder = RevealFeeder(src.schedule)
+def render_span(src: PerformanceInput, request: RenderRequest) -> tuple[float, float]:
+    """The session times of the first and last frames: the input's span, or --at,
+    --start, --end (seconds from the input's start); ConfigError when it is empty or huge."""
     t0, t1 = src.default_span()
-    base = (
-        src.start_s
-    )  # --at, --start, --end: seconds from the input's start (for MIDI files and recordings alike)
-    if args.start is not None:
-        t0 = base + args.start
-    if args.end is not None:
-        t1 = base + args.end
-    if args.at is not None:
-        t0 = t1 = base + args.at
+    base = src.start_s  # --at, --start, --end: from the input's start (MIDI files and recordings)
+    if request.start is not None:
+        t0 = base + request.start
+    if request.end is not None:
+        t1 = base + request.end
+    if request.at is not None:
+        t0 = t1 = base + request.at
         # everything known before the frame must have been fed: start the feeder there
     if t1 < t0:
         raise ConfigError(
             f"nothing to render: end {t1 - base:.3f} s is before start {t0 - base:.3f} s"
         )
     first_s, last_s = src.default_span()
-    if args.at is not None and not first_s <= base + args.at <= last_s:
+    if request.at is not None and not first_s <= base + request.at <= last_s:
         log.warning(
             "--at %.3f s is outside the performance (%.3f to %.3f s from the start of the "
             "input): the band is idle there",
-            args.at,
+            request.at,
             first_s - base,
             last_s - base,
         )
-    if (t1 - t0) * args.fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
+    fps = request.frames.fps
+    if (t1 - t0) * fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
         raise ConfigError(
-            f"the span {t0:.3f} .. {t1:.3f} s is {(t1 - t0) * args.fps:.0f} frames, more than "
+            f"the span {t0:.3f} .. {t1:.3f} s is {(t1 - t0) * fps:.0f} frames, more than "
             f"{MAX_FRAMES:,}; pick a part with --start and --end"
         )
-    dancer_db = getattr(args, "dancer", None)
+    return t0, t1
+
+
+def render_input(src: PerformanceInput, request: RenderRequest) -> int:
+    """Shared by `render` and `replay --out`: plan, animate, draw, encode."""
+    from virja.pipeline import build_performance
+    from virja.render.offline import render_offline
+    from virja.render.video import make_audio_track, temp_workdir
+    from virja.session import RevealFeeder
+
+    plan_log = open_plan_log(request.plan_log)
+    perf = build_performance(request.performance, src, animate=True, plan_log=plan_log)
+    animator = perf.animator
+    feeder = RevealFeeder(src.schedule)
+    t0, t1 = render_span(src, request)
+    out = request.frames.out
     with temp_workdir() as tmp:
         audio = None
-        if out.kind == "video" and not args.no_audio:
+        if out.kind == "video" and request.audio:
             audio, why_not = make_audio_track(
-                src.sound_events, src.sound_origin_s, Path(tmp), args.soundfont
+                src.sound_events, src.sound_origin_s, Path(tmp), request.soundfont
             )
             if why_not:
                 print(f"virja: {why_not}", file=sys.stderr)
-        progress = ProgressBar("rendering") if out.kind != "png" or args.at is None else None
         extra = None
-        if dancer_db is not None:
+        if request.dancer is not None:
             from virja.render.scene import figure_scene
 
-            track = session_dancer(src, dancer_db, audio, Path(tmp), args.soundfont)
+            track = session_dancer(src, request.dancer, audio, Path(tmp), request.soundfont)
 
             def extra(t: float) -> list[DrawList]:
                 return [figure_scene(track.pose(t))]
 
-        result = render_offline(
-            perf,
-            feeder,
-            t0_s=t0,
-            t1_s=t1,
-            fps=args.fps,
-            size=size,
-            out=out,
-            camera=choose_camera(args.camera, src, perf),
-            audio=audio,
-            audio_offset_s=src.sound_origin_s - t0,
-            samples=args.samples,
-            progress=progress,
-            extra=extra,
-            hud=getattr(args, "hud", False),
+        frames = replace(
+            request.frames.with_audio(audio, src.sound_origin_s - t0),
+            camera=choose_camera(request.camera, src, perf),
         )
+        result = render_offline(perf, feeder, (t0, t1), frames, extra=extra)
     if plan_log is not None:
         plan_log.close()
-    if args.bvh:
+    if request.bvh:
+        from virja.motion.band import BandAnimator
         from virja.motion.export import performance_to_bvh
 
-        for path in performance_to_bvh(animator, t0, t1, args.fps, Path(args.bvh)):
+        assert isinstance(animator, BandAnimator)
+        for path in performance_to_bvh(animator, t0, t1, frames.fps, Path(request.bvh)):
             print(f"wrote {path}")
     rate = result.frames / result.seconds if result.seconds > 0 else float("inf")
     where: object = out.path
@@ -270,7 +311,7 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         where = f"{result.outputs[0]} ... {result.outputs[-1].name}"
     print(
         f"wrote {result.frames} frame{'' if result.frames == 1 else 's'} "
-        f"({t1 - t0:.2f} s at {args.fps:g} fps from {t0 - src.start_s:.2f} s) to {where} "
+        f"({t1 - t0:.2f} s at {frames.fps:g} fps from {t0 - src.start_s:.2f} s) to {where} "
         f"in {result.seconds:.1f} s ({rate:.1f} frames/s); "
         f"planned {perf.counts['planned']} notes ({perf.counts['planned_late']} late)"
     )

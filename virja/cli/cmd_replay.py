@@ -23,18 +23,24 @@ import argparse
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from virja.cli.common import (
     SAMPLE_CHOICES,
     add_routing_arguments,
     finite_float,
-    make_router,
     open_plan_log,
+    performance_settings,
 )
-from virja.cli.web_option import add_web_arguments, open_web
+from virja.cli.web_option import add_web_arguments, web_settings
 from virja.errors import ConfigError, InputFileError
 from virja.render.camera import PRESETS
+
+if TYPE_CHECKING:
+    from virja.input import PerformanceInput
+    from virja.live.outputs import LiveSettings
+    from virja.pipeline import PerformanceSettings
+    from virja.session import Performance
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -76,46 +82,38 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from virja.cli.common import routing_config
     from virja.input import pcap_input
 
     if args.port is not None and not 1 <= args.port <= 65535:
         raise ConfigError(f"--port must be 1-65535, got {args.port}")
     if args.dancer and not args.out:
         raise ConfigError("--dancer draws into a rendering: give --out too")
+    settings = performance_settings(args)
+    request = None
     if args.out:
-        from virja.cli.cmd_render import check_outputs
-        from virja.render.offline import OutputSpec, parse_size
+        from virja.cli.cmd_render import check_outputs, render_request
 
-        args.at = args.start = args.end = None
-        args.bvh = None
-        size, out = parse_size(args.size), OutputSpec.from_path(args.out)
-        check_outputs(args, out)  # before the work
-    src = pcap_input(Path(args.input), routing_config(args), port=args.port, key_file=args.key_file)
+        # the whole recording: replay has no --at, --start, --end or --bvh
+        request = render_request(args, settings, span=False)
+        check_outputs(request)  # before the work
+    src = pcap_input(Path(args.input), settings.routing, port=args.port, key_file=args.key_file)
     for line in src.report:
         print(line)
     if not src.schedule:
         raise InputFileError(args.input, "the recording holds no valid RMCP events")
-    if args.out:
+    if request is not None:
         from virja.cli.cmd_render import render_input
 
-        return render_input(src, args, size, out)
-    return play(src, args)
+        return render_input(src, request)
+    return play(src, settings, args)
 
 
-def play(src: object, args: argparse.Namespace) -> int:
-    from virja.cli.rtp_midi import plan_config
-    from virja.input import PerformanceInput
-    from virja.plan.planner import OnlinePlanner
-    from virja.session import Performance, run_schedule
+def play(src: PerformanceInput, settings: PerformanceSettings, args: argparse.Namespace) -> int:
+    from virja.pipeline import build_performance
+    from virja.session import run_schedule
 
-    assert isinstance(src, PerformanceInput)
     plan_log = open_plan_log(args.plan_log)
-    perf = Performance(
-        router=make_router(args),
-        planner=OnlinePlanner(plan_config(args.config, immediate=src.immediate)),
-        plan_log=plan_log,
-    )
+    perf = build_performance(settings, src, plan_log=plan_log)
     try:
         if args.headless and not args.web:
             run_schedule(perf, src.schedule)
@@ -134,15 +132,30 @@ def play(src: object, args: argparse.Namespace) -> int:
 WINDOW_CHECK_S = 0.1  # the replay notices a closed window within this long
 
 
-def play_live(perf: Any, src: Any, args: argparse.Namespace) -> None:
+def live_settings(args: argparse.Namespace) -> LiveSettings:
+    """The window (unless --headless) and --web of a replay in real time."""
+    from virja.live.outputs import LiveSettings
+    from virja.live.viewer import ViewerSpec
+    from virja.render.offline import parse_size
+
+    window = None
+    if not args.headless:
+        window = ViewerSpec(  # --fps is the video's rate; the window follows the display
+            parse_size(args.size),
+            f"virja replay {Path(args.input).name}",
+            samples=args.samples,
+            camera=args.camera,
+            hud=args.hud,
+        )
+    return LiveSettings(window=window, web=web_settings(args))
+
+
+def play_live(perf: Performance, src: PerformanceInput, args: argparse.Namespace) -> None:
     """The recording in real time: this process feeds and plans, sleeping to the next
     reveal, motion start or web frame; the window's own process draws (as in `serve`);
     with --web the browsers' frames are posed here by an animator of our own."""
-    from virja.live.sinks import Fanout
+    from virja.live.outputs import LiveOutputs
     from virja.live.timer import wake_in
-    from virja.live.viewer import Viewer, ViewerSpec
-    from virja.motion.band import BandAnimator
-    from virja.render.offline import parse_size
     from virja.session import RevealFeeder
 
     feeder = RevealFeeder(src.schedule)
@@ -152,23 +165,9 @@ def play_live(perf: Any, src: Any, args: argparse.Namespace) -> None:
     def now_s() -> float:
         return float(t0 + (time.monotonic() - wall0[0]))
 
-    sinks = Fanout()
-    perf.animator = sinks
-    viewer = web = None
+    outputs = LiveOutputs.open(perf, live_settings(args), now_s)
+    viewer, web = outputs.viewer, outputs.web
     try:
-        if args.web:
-            sinks.add(BandAnimator())
-        if not args.headless:
-            spec = ViewerSpec(  # --fps is the video's rate; the window follows the display
-                parse_size(args.size),
-                f"virja replay {Path(args.input).name}",
-                samples=args.samples,
-                camera=args.camera,
-                hud=args.hud,
-            )
-            viewer = Viewer(spec, now_s)
-            sinks.add(viewer)
-        web = open_web(args, perf, now_s)
         if web is not None:
             print(f"virja replay: web viewer at {web.url}", flush=True)
         wall0[0] = time.monotonic()  # the recording starts once the window is open
@@ -184,13 +183,10 @@ def play_live(perf: Any, src: Any, args: argparse.Namespace) -> None:
             deadlines = [reveal, perf.planner.next_deadline(), t1, t + WINDOW_CHECK_S]
             if web is not None:
                 web.publish(perf, t)
-                sinks.forget_before(t - 20.0)
+                outputs.sinks.forget_before(t - 20.0)
                 deadlines.append(t + 1 / web.fps)
             time.sleep(wake_in(deadlines, now_s()))
     finally:
-        if viewer is not None:
-            viewer.close()
-        if web is not None:
-            web.close()
+        outputs.close()
     feeder.until(perf, math.inf)
     perf.finish()

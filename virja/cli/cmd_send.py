@@ -60,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     from virja.midifile import read_midi
     from virja.rmcp.sender import Route, SendOptions
     from virja.rmcp.signing import load_key
-    from virja.rmcp.streamer import stream
+    from virja.rmcp.streamer import SendSettings, stream
     from virja.rmcp.transport import parse_hostport
     from virja.routing import Router
 
@@ -88,19 +88,21 @@ def run(args: argparse.Namespace) -> int:
     try:
         stats = asyncio.run(
             stream(
-                to=(host, port),
+                SendSettings(
+                    (host, port),
+                    options,
+                    start_in_s=args.start_in,
+                    loop=args.loop,
+                    key=key,
+                    bind=bind,
+                ),
                 # chord symbols the file carries go out as CHORD messages
                 events=sorted([*session.events, *session.chords], key=lambda e: e.time_s),
                 tempo=session.tempo_map,
                 beats=session.beats,
                 duration_s=session.duration_s,
-                options=options,
                 route_factory=route_factory,
                 clock=SessionClock(),
-                start_in_s=args.start_in,
-                loop=args.loop,
-                key=key,
-                bind=bind,
                 on_bound=lambda a: print(
                     f"virja send: answering clock requests on {a[0]}:{a[1]}", flush=True
                 ),

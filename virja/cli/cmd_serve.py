@@ -25,19 +25,23 @@ import contextlib
 import signal
 import sys
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from virja.cli import rtp_midi
-from virja.cli.common import add_routing_arguments, finite_float, make_router, open_plan_log
-from virja.cli.web_option import add_web_arguments, open_web
+from virja.cli.common import (
+    add_routing_arguments,
+    finite_float,
+    open_plan_log,
+    performance_settings,
+)
+from virja.cli.web_option import add_web_arguments, web_settings
 from virja.config import load_config
 from virja.errors import ConfigError, NotAvailableError
 from virja.faults import survive_tick
 
 if TYPE_CHECKING:
-    from virja.live.audio import LiveSynth
+    from virja.live.outputs import LiveOutputs, LiveSettings
 
 STATUS_EVERY_S = 5.0
 RECORDER_FLUSH_S = 0.1  # the recording is flushed this often while it is open
@@ -274,33 +278,39 @@ def _report_clock_failure(task: asyncio.Task[Any]) -> None:
         print(f"virja serve: the clock client stopped: {exc}", file=sys.stderr, flush=True)
 
 
-def open_audio(args: argparse.Namespace, now_s: Callable[[], float]) -> LiveSynth:
-    """--audio: fluidsynth with the soundfont render would use (checked now, one line)."""
-    from virja.live.audio import LiveSynth
+def live_settings(args: argparse.Namespace, title: str) -> LiveSettings:
+    """The window (unless --headless), --web and --audio (its soundfont found now: one
+    line when there is none)."""
+    from virja.live.outputs import AudioSettings, LiveSettings
+    from virja.live.viewer import ViewerSpec
+    from virja.render.offline import parse_size
     from virja.render.video import find_soundfont
 
-    sf = find_soundfont(args.soundfont)
-    if sf is None:
-        raise NotAvailableError(
-            "--audio needs a General MIDI soundfont: apt-get install fluid-soundfont-gm, "
-            "--soundfont FILE.sf2 or VIRJA_SOUNDFONT"
-        )
-    return LiveSynth(sf, now_s, driver=args.audio_driver)
+    audio = None
+    if args.audio:
+        sf = find_soundfont(args.soundfont)
+        if sf is None:
+            raise NotAvailableError(
+                "--audio needs a General MIDI soundfont: apt-get install fluid-soundfont-gm, "
+                "--soundfont FILE.sf2 or VIRJA_SOUNDFONT"
+            )
+        audio = AudioSettings(sf, args.audio_driver)
+    window = None
+    if not args.headless:
+        window = ViewerSpec(parse_size(args.size), title, args.fps, hud=args.hud)
+    return LiveSettings(window=window, web=web_settings(args), audio=audio)
 
 
 async def serve(args: argparse.Namespace) -> int:
     from virja.clock import SessionClock
-    from virja.live.sinks import Fanout
+    from virja.live.outputs import LiveOutputs
     from virja.live.timer import DeadlineTimer, wake_in
-    from virja.live.viewer import Viewer, ViewerSpec
-    from virja.plan.planner import OnlinePlanner
-    from virja.render.offline import parse_size
+    from virja.pipeline import build_performance
     from virja.rmcp.pcap import PcapWriter
     from virja.rmcp.receiver import Receiver, ReceiverConfig
     from virja.rmcp.signing import load_key
     from virja.rmcp.stamped import open_stamped_listener
     from virja.rmcp.transport import ClockClient, RmcpProtocol, parse_hostport
-    from virja.session import Performance
 
     load_config(args.config)  # fail early on a bad file
     if args.duration is not None and args.duration <= 0:
@@ -318,10 +328,8 @@ async def serve(args: argparse.Namespace) -> int:
     if clock_server is not None:
         _resolve_or_fail(clock_server, "--clock-server")
     # bind first: a port in use must not cost the user an existing plan log or recording
-    perf = Performance(
-        router=make_router(args),
-        planner=OnlinePlanner(rtp_midi.plan_config(args.config, immediate=bool(args.rtp_midi))),
-    )
+    # RTP-MIDI notes are played at once: the shortest strokes (docs/rtp-midi.md)
+    perf = build_performance(performance_settings(args, immediate=bool(args.rtp_midi)))
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
     if not 1 <= args.fps <= 1000:
         raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
@@ -329,27 +337,14 @@ async def serve(args: argparse.Namespace) -> int:
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
     transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
-    viewer = web = rtp = synth = None
-    sinks = Fanout()  # where committed motions go: the window's process, an animator for --web
+    rtp = None
+    outputs: LiveOutputs | None = None  # the window's process, the browsers, the speakers
     try:
-        web = open_web(args, perf, lambda: clock.now_us() / 1e6)
-        if args.audio:
-            synth = open_audio(args, clock.now_s)
-            perf.taps.append(synth)
+        outputs = LiveOutputs.open(
+            perf, live_settings(args, f"virja serve {host}:{port}"), clock.now_s
+        )
         rtp = await rtp_midi.start_serve(args, clock, daemon)
-        if web is not None:  # the browsers' frames are posed here, by an animator of our own
-            from virja.motion.band import BandAnimator
-
-            sinks.add(BandAnimator())
-        if not args.headless:
-            viewer = Viewer(
-                ViewerSpec(
-                    parse_size(args.size), f"virja serve {host}:{port}", args.fps, hud=args.hud
-                ),
-                clock.now_s,
-            )
-            sinks.add(viewer)
-        perf.animator = sinks if sinks.sinks else None
+        viewer, web, sinks = outputs.viewer, outputs.web, outputs.sinks
         daemon.viewer = viewer
         perf.plan_log = open_plan_log(args.plan_log)
         if args.record:
@@ -362,14 +357,10 @@ async def serve(args: argparse.Namespace) -> int:
                 rtp.recorder = recorder
     except BaseException:
         transport.close()
-        if synth is not None:
-            synth.close()
         if rtp is not None:
             await rtp.close()
-        if viewer is not None:
-            viewer.close()
-        if web is not None:
-            web.close()
+        if outputs is not None:
+            outputs.close()
         if perf.plan_log is not None:
             perf.plan_log.close()
         raise
@@ -437,9 +428,7 @@ async def serve(args: argparse.Namespace) -> int:
         transport.close()
         if rtp is not None:
             await rtp.close()
-        if synth is not None:
-            with survive_tick():
-                synth.close()
+        outputs.close_audio()
         if viewer is not None:
             loop.remove_reader(viewer.sentinel)
         # each step on its own: a failure is one warning, and the summary still comes
@@ -453,12 +442,7 @@ async def serve(args: argparse.Namespace) -> int:
         if plan_log is not None:
             with survive_tick():
                 plan_log.close()
-        if viewer is not None:
-            with survive_tick():
-                viewer.close()
-        if web is not None:
-            with survive_tick():
-                web.close()
+        outputs.close()  # the window and the web viewer
     print("virja serve: stopped")
     extra = ([web.summary()] if web is not None else []) + (rtp.summary() if rtp else [])
     for line in daemon.summary() + extra:

@@ -6,11 +6,14 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 from virja.config import load_config, section
 from virja.errors import ConfigError
-from virja.routing import Router, RoutingConfig
+from virja.routing import RoutingConfig
+
+if TYPE_CHECKING:
+    from virja.pipeline import PerformanceSettings
 
 
 def finite_float(text: str) -> float:
@@ -76,11 +79,16 @@ def routing_config(args: argparse.Namespace, doc: dict[str, Any] | None = None) 
     )
 
 
-def make_router(args: argparse.Namespace, session: Any = None) -> Router:
-    cfg = routing_config(args)
-    if session is not None:
-        return Router.for_session(session, cfg)
-    return Router(cfg)
+def performance_settings(
+    args: argparse.Namespace, doc: dict[str, Any] | None = None, *, immediate: bool = False
+) -> PerformanceSettings:
+    """The routing (flags over ``[routing]``) and the plan tables of ``--config``, parsed
+    once for :func:`virja.pipeline.build_performance`; each error a one-line ConfigError."""
+    from virja.pipeline import PerformanceSettings
+    from virja.plan.config import load_plan_config
+
+    routing = routing_config(args, doc)
+    return PerformanceSettings(load_plan_config(args.config), routing, immediate=immediate)
 
 
 def open_plan_log(path: str | None) -> IO[str] | None:

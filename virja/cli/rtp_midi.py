@@ -9,16 +9,6 @@ from typing import Any
 from virja.rtpmidi import DEFAULT_PORT
 
 
-def plan_config(config_path: str | None, *, immediate: bool) -> Any:
-    """The scheduler's tables; with ``immediate`` (RTP-MIDI notes, live or recorded)
-    those of a jam without delay: a note's stroke lands as soon as the shortest allows."""
-    from virja.plan.config import load_plan_config
-    from virja.plan.immediate import immediate_strokes
-
-    config = load_plan_config(config_path)
-    return immediate_strokes(config) if immediate else config
-
-
 def add_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--rtp-midi",

@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from virja.errors import ConfigError
 
 if TYPE_CHECKING:
-    from virja.session import Performance
-    from virja.web.feed import WebFeed
+    from virja.live.outputs import WebSettings
 
 DEFAULT_WEB = "127.0.0.1:8080"
 
@@ -40,24 +38,15 @@ def add_web_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-def open_web(
-    args: argparse.Namespace, perf: Performance, now_s: Callable[[], float]
-) -> WebFeed | None:
-    """Start the viewer's server when --web is given (its address in ``feed.url``)."""
+def web_settings(args: argparse.Namespace) -> WebSettings | None:
+    """The browser viewer's settings when --web is given; a one-line ConfigError for bad
+    values."""
     if not getattr(args, "web", None):
         return None
+    from virja.live.outputs import WebSettings
     from virja.rmcp.transport import parse_hostport
-    from virja.web.feed import WebFeed
 
     host, port = parse_hostport(args.web, default_port=8080)
     if not 0.0 <= args.web_lead_ms <= 2000.0:
         raise ConfigError(f"--web-lead-ms must be 0-2000, got {args.web_lead_ms:g}")
-    try:
-        feed = WebFeed(host, port, now_s, fps=args.web_fps, lead_s=args.web_lead_ms / 1000)
-    except ValueError as exc:
-        raise ConfigError(f"--web-fps: {exc}") from None
-    bound = feed.start()
-    feed.attach(perf)
-    shown = f"[{bound[0]}]" if ":" in bound[0] else bound[0]
-    feed.url = f"http://{shown}:{bound[1]}/"
-    return feed
+    return WebSettings(host, port, fps=args.web_fps, lead_s=args.web_lead_ms / 1000)

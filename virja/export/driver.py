@@ -25,12 +25,11 @@ from virja.geometry import GEOMETRY
 from virja.input import PerformanceInput, load_performance_input, nothing_for_the_band
 from virja.motion.band import FIGURES, BandAnimator
 from virja.motion.export import performance_to_bvh
+from virja.pipeline import PerformanceSettings, build_performance
 from virja.plan.config import PlanConfig, load_plan_config
-from virja.plan.immediate import immediate_strokes
-from virja.plan.planner import OnlinePlanner
 from virja.plan.types import PlannedNote
-from virja.routing import Router, RoutingConfig
-from virja.session import Performance, run_schedule
+from virja.routing import RoutingConfig
+from virja.session import run_schedule
 from virja.vocab import BASS_STRINGS, CYMBAL_PIECES
 
 GLTF_SUFFIXES = (".glb", ".gltf")
@@ -194,14 +193,12 @@ def export_performance(
     if src.note_count == 0:
         raise nothing_for_the_band(src_path, src.report)
     # notation needs only the plan: MusicXML alone skips the animator (so a tuning the
-    # bassist's clips do not cover yet still gets its tablature)
-    animator = BandAnimator() if (g or b) else None
-    router = Router.for_session(src.midi, routing) if src.midi is not None else Router(routing)
-    if src.immediate:  # a recording's RTP-MIDI notes were played at once, as live
-        plan_config = immediate_strokes(plan_config)
-    perf = Performance(
-        router=router, planner=OnlinePlanner(plan_config, tempo=src.tempo), animator=animator
-    )
+    # bassist's clips do not cover yet still gets its tablature); a recording's RTP-MIDI
+    # notes were played at once, as live: the pipeline gives them the shortest strokes
+    perf = build_performance(PerformanceSettings(plan_config, routing), src, animate=bool(g or b))
+    plan_config = perf.planner.config  # the tables it planned with (the score's too)
+    animator = perf.animator
+    assert animator is None or isinstance(animator, BandAnimator)
     planned = run_schedule(perf, src.schedule)
     t0, t1 = src.default_span()
     t0 = t0 if start_s is None else start_s

@@ -15,11 +15,9 @@ the band, ``virja render --dancer`` passes the dancer to
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 
 from virja.motion.pose import FigurePose
-from virja.render.camera import Camera
-from virja.render.offline import OutputSpec, Progress, RenderResult, render_frames
+from virja.render.offline import RenderResult, RenderSettings, render_frames
 from virja.render.renderer import DrawList
 from virja.render.scene import add_floor, figure_scene
 from virja.session import frame_times
@@ -35,33 +33,12 @@ def floor_scene(size_m: tuple[float, float] = (6.0, 4.0)) -> DrawList:
 
 
 def render_dancer_alone(
-    dancer: DancerPose,
-    *,
-    t0_s: float,
-    t1_s: float,
-    fps: float,
-    size: tuple[int, int],
-    out: OutputSpec,
-    camera: Camera,
-    audio: Path | None = None,
-    audio_offset_s: float = 0.0,
-    samples: int = 1,
-    progress: Progress | None = None,
+    dancer: DancerPose, span: tuple[float, float], settings: RenderSettings
 ) -> RenderResult:
-    """The stage floor and ``dancer(t)`` from ``t0_s`` to ``t1_s``; ``audio`` starts at
-    ``audio_offset_s`` into the video."""
-    times = list(frame_times(t0_s, t1_s, fps))
+    """The stage floor and ``dancer(t)`` over ``span`` (seconds, both ends drawn); the
+    settings' audio starts ``audio_offset_s`` into the video."""
+    t0_s, t1_s = span
+    times = list(frame_times(t0_s, t1_s, settings.fps))
     floor = floor_scene()
-    seconds, outputs = render_frames(
-        times,
-        lambda t: [floor, figure_scene(dancer(t))],
-        fps=fps,
-        size=size,
-        out=out,
-        camera=camera,
-        audio=audio,
-        audio_offset_s=audio_offset_s,
-        samples=samples,
-        progress=progress,
-    )
+    seconds, outputs = render_frames(times, lambda t: [floor, figure_scene(dancer(t))], settings)
     return RenderResult(len(times), seconds, t0_s, outputs)

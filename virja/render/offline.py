@@ -13,11 +13,11 @@ import math
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from virja.errors import ConfigError
-from virja.render.camera import Camera
+from virja.render.camera import PRESETS, Camera
 from virja.render.glflush import flush
 from virja.render.hosts import OffscreenTarget, create_headless_context
 from virja.render.hud import HudOverlay
@@ -74,6 +74,32 @@ CameraAt = Callable[[float], Camera]  # a camera that moves (render.director.Fol
 TextAt = Callable[[float], str]  # the heads-up display's line at a frame time
 
 
+@dataclass(frozen=True)
+class RenderSettings:
+    """How frames are drawn and where they go: built once from a command's options
+    (``render``, ``replay --out``, ``dance --render``, a batch's mp4).
+
+    ``out``: the files; ``camera``: a preset or one that moves with the time;
+    ``samples``: multisampling; ``hud``: draw the heads-up display; ``audio``: the
+    sound track of a video, starting ``audio_offset_s`` into it; ``progress(done,
+    total, elapsed_s)`` after each frame.
+    """
+
+    out: OutputSpec
+    size: tuple[int, int] = (1280, 720)
+    fps: float = 30.0
+    camera: Camera | CameraAt = field(default_factory=lambda: PRESETS["front"])
+    samples: int = 1
+    hud: bool = False
+    audio: Path | None = None
+    audio_offset_s: float = 0.0
+    progress: Progress | None = None
+
+    def with_audio(self, audio: Path | None, offset_s: float) -> RenderSettings:
+        """The same settings with a sound track (made once the span is known)."""
+        return replace(self, audio=audio, audio_offset_s=offset_s)
+
+
 @dataclass
 class RenderResult:
     frames: int
@@ -88,27 +114,24 @@ SceneAt = Callable[[float], list[DrawList]]
 def render_frames(
     times: list[float],
     scene_at: SceneAt,
+    settings: RenderSettings,
     *,
-    fps: float,
-    size: tuple[int, int],
-    out: OutputSpec,
-    camera: Camera | CameraAt,
-    audio: Path | None = None,
-    audio_offset_s: float = 0.0,
-    samples: int = 1,
-    progress: Progress | None = None,
     hud: TextAt | None = None,
 ) -> tuple[float, list[Path]]:
-    """Draw ``scene_at(t)`` for each frame time and write it to ``out``.
+    """Draw ``scene_at(t)`` for each frame time and write it to ``settings.out``
+    (``hud(t)``: the heads-up display's line, when ``settings.hud``).
 
     The one frame loop of every offline render (band, band and dancer, dancer
     alone).  Returns the seconds it took and the files written.
     """
+    out, size, fps = settings.out, settings.size, settings.fps
+    camera, progress = settings.camera, settings.progress
+    hud = hud if settings.hud else None
     if out.kind == "video" and (size[0] % 2 or size[1] % 2):
         raise ConfigError(f"video needs an even frame size, got {size[0]}x{size[1]}")
     ctx = create_headless_context()
     renderer = Renderer(ctx)
-    target = OffscreenTarget(ctx, size, samples=samples)
+    target = OffscreenTarget(ctx, size, samples=settings.samples)
     overlay = HudOverlay(ctx) if hud is not None else None
     writer: VideoWriter | None = None
     outputs: list[Path] = []
@@ -126,8 +149,8 @@ def render_frames(
             out.path,
             size,
             fps,
-            audio=audio,
-            audio_offset_s=audio_offset_s,
+            audio=settings.audio,
+            audio_offset_s=settings.audio_offset_s,
             bottom_up=True,
             queue_frames=3,
         )
@@ -174,25 +197,18 @@ def render_frames(
 def render_offline(
     perf: Performance,
     feeder: RevealFeeder,
+    span: tuple[float, float],
+    settings: RenderSettings,
     *,
-    t0_s: float,
-    t1_s: float,
-    fps: float,
-    size: tuple[int, int],
-    out: OutputSpec,
-    camera: Camera | CameraAt,
-    audio: Path | None = None,
-    audio_offset_s: float = 0.0,
-    samples: int = 1,
-    progress: Progress | None = None,
     extra: SceneAt | None = None,
-    hud: bool = False,
 ) -> RenderResult:
-    """Drive ``perf`` from t0 to t1 at ``fps`` and write each frame to ``out``.
+    """Drive ``perf`` over ``span`` (session seconds, both ends drawn) at
+    ``settings.fps`` and write each frame to ``settings.out``.
 
     ``extra(t)`` adds instances to each frame (the dancer, for one).
     """
-    times = list(frame_times(t0_s, t1_s, fps))
+    t0_s, t1_s = span
+    times = list(frame_times(t0_s, t1_s, settings.fps))
     static = static_scene()
 
     def scene_at(t: float) -> list[DrawList]:
@@ -201,19 +217,7 @@ def render_offline(
         layers = [static, band_scene(perf.pose(t))]
         return layers if extra is None else layers + extra(t)
 
-    seconds, outputs = render_frames(
-        times,
-        scene_at,
-        fps=fps,
-        size=size,
-        out=out,
-        camera=camera,
-        audio=audio,
-        audio_offset_s=audio_offset_s,
-        samples=samples,
-        progress=progress,
-        hud=(lambda t: perf.hud.at(t).text()) if hud else None,
-    )
+    seconds, outputs = render_frames(times, scene_at, settings, hud=lambda t: perf.hud.at(t).text())
     feeder.until(perf, math.inf)
     perf.finish()
     return RenderResult(len(times), seconds, t0_s, outputs)

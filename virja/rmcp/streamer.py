@@ -11,7 +11,7 @@ import asyncio
 import logging
 import socket
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, cast
 
 from virja.clock import SessionClock
@@ -56,25 +56,41 @@ class _SendProtocol(asyncio.DatagramProtocol):
             self.stats.clock_replies += 1
 
 
+@dataclass(frozen=True)
+class SendSettings:
+    """Where and how a performance is streamed, parsed once from `virja send`'s options.
+
+    ``to``: the receiver; ``options``: lead and sender id (the pure schedule's);
+    ``start_in_s``: the first pass starts this long after the call; ``loop``: pass
+    after pass until cancelled (``max_passes`` at most, for tests); ``key``: HMAC
+    signing; ``bind``: the local address clock requests are answered on.
+    """
+
+    to: tuple[str, int]
+    options: SendOptions = field(default_factory=SendOptions)
+    start_in_s: float = 1.0
+    loop: bool = False
+    key: bytes | None = None
+    bind: tuple[str, int] | None = None
+    max_passes: int | None = None
+
+
 async def stream(
+    settings: SendSettings,
     *,
-    to: tuple[str, int],
     events: Sequence[Event],
     tempo: Tempo,
     beats: Sequence[Beat],
     duration_s: float,
-    options: SendOptions,
     route_factory: Callable[[], Route],
     clock: SessionClock,
-    start_in_s: float = 1.0,
-    loop: bool = False,
-    key: bytes | None = None,
-    max_passes: int | None = None,
     on_sent: Callable[[Scheduled], None] | None = None,
-    bind: tuple[str, int] | None = None,
     on_bound: Callable[[tuple[str, int]], None] | None = None,
 ) -> StreamStats:
-    """Stream the performance to ``to``; returns when done (or runs forever with ``loop``)."""
+    """Stream the performance to ``settings.to``; returns when done (or runs forever
+    with ``settings.loop``)."""
+    to, options, key, bind = settings.to, settings.options, settings.key, settings.bind
+    start_in_s, loop, max_passes = settings.start_in_s, settings.loop, settings.max_passes
     stats = StreamStats()
     aloop = asyncio.get_running_loop()
     infos = socket.getaddrinfo(to[0], to[1], type=socket.SOCK_DGRAM)

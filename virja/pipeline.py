@@ -1,0 +1,99 @@
+"""The one place a performance is put together: router + planner + animator + plan log.
+
+Every command that plays notes (``serve``, ``render``, ``replay``, ``jam``,
+``plan`` on a recording, ``export``, ``batch``) and the capture tools build
+their :class:`~virja.session.Performance` here, from a
+:class:`PerformanceSettings` parsed once from the command line (or handed to a
+batch worker) and, for a file or a recording, its
+:class:`~virja.input.PerformanceInput`:
+
+    settings = PerformanceSettings(plan=load_plan_config(path), routing=routing)
+    perf = build_performance(settings, src, animate=True, plan_log=fh)
+
+What differs between commands is only data: the tables (a jam without delay and
+RTP-MIDI notes, played at once, get the shortest strokes: ``immediate``), the
+routing (a MIDI file's router knows its track names) and the tempo (a file's
+tempo map; a recording or a live session learns it from BEAT messages).
+Outputs that want planned motions (the window's process, an animator for the
+browsers) join as the performance's ``animator`` (a ``live.sinks.Fanout``);
+drawing to files is :mod:`virja.render.offline` with its ``RenderSettings``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import IO, TYPE_CHECKING
+
+from virja.plan.config import PlanConfig, load_plan_config
+from virja.routing import Router, RoutingConfig
+from virja.session import Performance, PlanSink
+
+if TYPE_CHECKING:
+    from virja.input import PerformanceInput
+
+
+def _default_plan() -> PlanConfig:
+    return load_plan_config(None)
+
+
+@dataclass(frozen=True)
+class PerformanceSettings:
+    """What a performance is built from, parsed once (plain data: it pickles, so a
+    batch worker gets it whole).
+
+    ``plan``: the scheduler's tables (``[plan]`` and motions/*.toml); ``routing``:
+    who plays what, flags already applied over ``[routing]``; ``immediate``: notes are
+    played as they arrive (a jam without delay, RTP-MIDI), so strokes are cut to the
+    shortest (:mod:`virja.plan.immediate`).
+    """
+
+    plan: PlanConfig = field(default_factory=_default_plan)
+    routing: RoutingConfig = field(default_factory=RoutingConfig)
+    immediate: bool = False
+
+    def tables(self) -> PlanConfig:
+        """The tables the planner gets: ``plan``, or its immediate strokes."""
+        if not self.immediate:
+            return self.plan
+        from virja.plan.immediate import immediate_strokes
+
+        return immediate_strokes(self.plan)
+
+
+def build_performance(
+    settings: PerformanceSettings,
+    src: PerformanceInput | None = None,
+    *,
+    animate: bool = False,
+    animator: PlanSink | None = None,
+    plan_log: IO[str] | None = None,
+) -> Performance:
+    """Router + planner (+ animator, + plan log) for one performance.
+
+    With ``src`` (a MIDI file or a recording) the router knows the file's track
+    names, the planner its tempo map, and a recording's RTP-MIDI notes (played at
+    once, as live) get the shortest strokes.  ``animate`` gives it a
+    :class:`~virja.motion.band.BandAnimator` (poses in this process); ``animator``
+    any other :class:`~virja.session.PlanSink` (the live outputs' fan-out).
+    """
+    from virja.plan.planner import OnlinePlanner
+
+    if animate and animator is not None:
+        raise ValueError("give animate or an animator, not both")
+    if src is not None and src.immediate and not settings.immediate:
+        settings = PerformanceSettings(settings.plan, settings.routing, immediate=True)
+    midi = src.midi if src is not None else None
+    router = (
+        Router.for_session(midi, settings.routing) if midi is not None else Router(settings.routing)
+    )
+    if animate:
+        from virja.motion.band import BandAnimator
+
+        animator = BandAnimator()
+    tempo = src.tempo if src is not None else None
+    return Performance(
+        router=router,
+        planner=OnlinePlanner(settings.tables(), tempo=tempo),
+        animator=animator,
+        plan_log=plan_log,
+    )

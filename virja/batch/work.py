@@ -66,7 +66,9 @@ def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> lis
     perf = _performance(src, settings, animate=False)
     planned = run_schedule(perf, src.schedule)
     path = out / "plan.jsonl"
-    path.write_text("".join(json.dumps(p.to_json()) + "\n" for p in planned), encoding="utf-8")
+    path.write_text(
+        "".join(json.dumps(p.to_json(src.start_s)) + "\n" for p in planned), encoding="utf-8"
+    )
     return [path]
 
 

@@ -219,6 +219,7 @@ def run(args: argparse.Namespace) -> int:
             delay_s=opts.delay_s,
             config_path=args.config,
         )
+        perf.origin_s = clock.now_s()  # the plan log counts from the jam's start
         view = None
         if not args.headless:  # the window draws in its own process (see virja.live.viewer)
             from virja.live.sinks import Fanout

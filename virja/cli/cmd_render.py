@@ -88,19 +88,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--at",
         type=finite_float,
         metavar="SECONDS",
-        help="render only the frame at this time (with a .png OUT)",
+        help="render only the frame at this time, seconds from the input's start "
+        "(a recording's first packet; with a .png OUT)",
     )
     p.add_argument(
         "--start",
         type=finite_float,
         metavar="SECONDS",
-        help="first frame time (default: early enough for the first motion)",
+        help="first frame, seconds from the input's start (default: early enough for "
+        "the first motion)",
     )
     p.add_argument(
         "--end",
         type=finite_float,
         metavar="SECONDS",
-        help="last frame time (default: the end plus 1.5 s)",
+        help="last frame, seconds from the input's start (default: the end plus 1.5 s)",
     )
     p.add_argument(
         "--samples",
@@ -188,13 +190,15 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
     planner = OnlinePlanner(plan_config(args.config, immediate=src.immediate), tempo=src.tempo)
     animator = BandAnimator()
     perf = Performance(
-        router=make_router(args, src.midi), planner=planner, animator=animator, plan_log=plan_log
+        router=make_router(args, src.midi),
+        planner=planner,
+        animator=animator,
+        plan_log=plan_log,
+        origin_s=src.start_s,
     )
     feeder = RevealFeeder(src.schedule)
     t0, t1 = src.default_span()
-    base = (
-        src.start_s
-    )  # --at, --start, --end: seconds from the input's start (for MIDI files and recordings alike)
+    base = src.start_s  # --at/--start/--end count from the input's start, MIDI or recording
     if args.start is not None:
         t0 = base + args.start
     if args.end is not None:
@@ -217,7 +221,8 @@ def render_input(src: object, args: argparse.Namespace, size: tuple[int, int], o
         )
     if (t1 - t0) * args.fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
         raise ConfigError(
-            f"the span {t0:.3f} .. {t1:.3f} s is {(t1 - t0) * args.fps:.0f} frames, more than "
+            f"the span {t0 - base:.3f} .. {t1 - base:.3f} s is {(t1 - t0) * args.fps:.0f} "
+            f"frames, more than "
             f"{MAX_FRAMES:,}; pick a part with --start and --end"
         )
     dancer_db = getattr(args, "dancer", None)
@@ -299,7 +304,10 @@ def choose_camera(name: str, src: object, perf: object) -> Camera | FollowCamera
     shots = plan_shots(notes, *src.default_span())
     print(
         f"follow camera: {len(shots)} shots: "
-        + ", ".join(f"{s.name} {s.start_s:.1f}-{s.end_s:.1f} s" for s in shots[:8])
+        + ", ".join(  # seconds from the input's start, as --at counts
+            f"{s.name} {s.start_s - src.start_s:.1f}-{s.end_s - src.start_s:.1f} s"
+            for s in shots[:8]
+        )
         + (" ..." if len(shots) > 8 else "")
     )
     return FollowCamera(shots)

@@ -115,6 +115,7 @@ def play(src: object, args: argparse.Namespace) -> int:
         router=make_router(args),
         planner=OnlinePlanner(plan_config(args.config, immediate=src.immediate)),
         plan_log=plan_log,
+        origin_s=src.start_s,  # the log counts from the recording's first packet
     )
     try:
         if args.headless and not args.web:

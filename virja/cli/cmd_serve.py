@@ -147,6 +147,11 @@ class Daemon:
     late_notes: int = 0
     started_s: float = field(default_factory=time.monotonic)
 
+    def arrived(self, now_us: int) -> None:
+        """A datagram arrived: the first is the start of the session (what a recording
+        of it starts with), from which the plan log counts its times."""
+        self.perf.mark_origin(now_us / 1e6)
+
     def on_events(self, received: list[Any], now_s: float) -> None:
         from virja.events import NoteOn
 
@@ -321,12 +326,14 @@ async def serve(args: argparse.Namespace) -> int:
     perf = Performance(
         router=make_router(args),
         planner=OnlinePlanner(rtp_midi.plan_config(args.config, immediate=bool(args.rtp_midi))),
+        origin_s=None,  # the first datagram's arrival (Daemon.arrived)
     )
     perf.keep_planned = False  # a daemon runs for hours: memory stays flat
     if not 1 <= args.fps <= 1000:
         raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
     daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
+    protocol.on_arrival = daemon.arrived
     transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
     viewer = web = rtp = synth = None

@@ -171,8 +171,9 @@ def export_performance(
     - ``gltf``: ``.glb`` or ``.gltf`` (+ ``.bin``), both figures and the instruments animated;
     - ``bvh``: ``NAME.bvh`` writes ``NAME_drums.bvh`` and ``NAME_bass.bvh``;
     - ``musicxml``: ``.musicxml`` (MusicXML 4.0, uncompressed);
-    - ``fps``: motion sampling rate; ``start_s``/``end_s``: the span in session
-      seconds (default: from the first motion to the last note plus 1.5 s);
+    - ``fps``: motion sampling rate; ``start_s``/``end_s``: the span in seconds from
+      the input's start, a recording's first packet (default: from the first motion to
+      the last note plus 1.5 s);
     - ``config``: a virja TOML file ([routing], [plan]); ``routing`` overrides its [routing]
       and ``plan_config`` (already parsed, as `virja batch` hands it to its workers) its [plan].
 
@@ -203,10 +204,14 @@ def export_performance(
     )
     planned = run_schedule(perf, src.schedule)
     t0, t1 = src.default_span()
-    t0 = t0 if start_s is None else start_s
-    t1 = t1 if end_s is None else end_s
+    # start_s/end_s count from the input's start (a recording's first packet), as render's
+    t0 = t0 if start_s is None else src.start_s + start_s
+    t1 = t1 if end_s is None else src.start_s + end_s
     if t1 < t0:
-        raise ConfigError(f"nothing to export: end {t1:.3f} s is before start {t0:.3f} s")
+        raise ConfigError(
+            f"nothing to export: end {t1 - src.start_s:.3f} s is before start "
+            f"{t0 - src.start_s:.3f} s"
+        )
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
     times = t0 + np.arange(n) / fps
     outputs: list[Path] = []

@@ -74,8 +74,8 @@ class PlannedNote:
         float noise; the channel 1-16 (10 for drums) as every message and option names
         it (it is 0-15 inside)."""
         out = {key: getattr(self, key) for key in JSON_KEYS}
-        for key in _TIMES:
-            out[key] = round(out[key] - origin_s, 6)
+        for key in _TIMES:  # the session time's microsecond, then from the origin
+            out[key] = round(round(out[key], 6) - origin_s, 6)
         out["channel"] = self.channel + 1  # 1-16, as musicians and every message count
         return out
 

@@ -61,10 +61,11 @@ class Performance:
         origin_s: float | None = 0.0,
     ) -> None:
         self.router = router
+        self.planner = planner
         # the session time users call 0: a MIDI file's start (0), a recording's first
         # packet; None until :meth:`mark_origin` (serve: the first datagram received)
+        self._origin_s: float | None = None
         self.origin_s = origin_s
-        self.planner = planner
         self.animator = animator
         setter = getattr(animator, "set_articulations", None)
         if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
@@ -80,6 +81,16 @@ class Performance:
         strings = getattr(animator, "use_bass_strings", None)
         if strings is not None:  # the bassist plays (and shows) the strings of the tuning
             strings(tuple(name for name, _ in planner.config.bass.strings))
+
+    @property
+    def origin_s(self) -> float | None:
+        return self._origin_s
+
+    @origin_s.setter
+    def origin_s(self, session_s: float | None) -> None:
+        self._origin_s = session_s
+        if session_s is not None and hasattr(self.planner, "origin_s"):
+            self.planner.origin_s = session_s  # its messages count from there too
 
     def mark_origin(self, session_s: float) -> None:
         """The input starts at ``session_s`` unless its start is known already."""

@@ -239,4 +239,5 @@ def score_of(
         beats=beats,
         time_signatures=list(src.midi.time_signatures) if src.midi is not None else [],
         title=src.path.stem,
+        origin_s=src.start_s,  # no BEATs in a recording: its beats count from its start
     )

@@ -167,6 +167,8 @@ class OnlinePlanner:
         self._counts: Counter[str] = Counter()
         self._unplayed: Counter[str] = Counter()  # per instrument: not a kit drummer's
         self._seq = 0
+        # for messages only: times are said from the input's start (Performance sets it)
+        self.origin_s = 0.0
 
     # -- inputs ---------------------------------------------------------------
 
@@ -254,7 +256,7 @@ class OnlinePlanner:
             "dropped %s note %d at %.3f s: %s",
             rec.performer,
             rec.note.note,
-            rec.note.time_s,
+            rec.note.time_s - self.origin_s,
             reason,
         )
         self._dropped.append(DroppedNote(rec.performer, rec.note, reason))

@@ -50,7 +50,9 @@ def test_from_json_rejects_missing_keys() -> None:
 
 # a recording's times inside are Unix seconds; its JSON counts from its first packet
 ORIGIN = 1_795_393_538.25
-LIVE = PlannedNote(**{**P.__dict__, "time": ORIGIN + 1.0, "start": ORIGIN + 0.8, "impact": ORIGIN + 1.0})
+LIVE = PlannedNote(
+    **{**P.__dict__, "time": ORIGIN + 1.0, "start": ORIGIN + 0.8, "impact": ORIGIN + 1.0}
+)
 
 
 def test_json_times_count_from_the_inputs_start() -> None:

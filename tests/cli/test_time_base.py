@@ -146,3 +146,18 @@ def test_serve_without_a_known_start_counts_from_the_first_motion() -> None:
     assert line["session_time"] == round(p.time, 6)
     perf.mark_origin(0.0)  # known already: kept
     assert perf.origin_s == p.start
+
+
+def test_gltf_of_a_recording_says_its_start_from_the_first_packet(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import struct
+
+    rec = recording(tmp_path / "s.pcap")
+    glb = tmp_path / "s.glb"
+    assert main(["export", str(rec), "--gltf", str(glb), "--fps", "10"]) == 0
+    data = glb.read_bytes()
+    (length,) = struct.unpack_from("<I", data, 12)
+    extras = json.loads(data[20 : 20 + length])["scenes"][0]["extras"]["virja"]
+    assert extras["origin_s"] == T0_US / 1e6
+    assert 0.0 <= extras["t0_s"] < 0.5  # the first packet or motion, before the first note

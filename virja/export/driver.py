@@ -96,9 +96,15 @@ def check_request(
         _check_out(musicxml, "--musicxml", (".musicxml", ".xml"))
 
 
-def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None = None) -> Sampled:
+def sample(
+    animator: BandAnimator,
+    times: np.ndarray,
+    local: np.ndarray | None = None,
+    origin_s: float = 0.0,
+) -> Sampled:
     """The band at ``times`` (sorted), as arrays for the glTF writer (``local``: the
-    animator's ``local_rotations_many(times)`` if the caller has it)."""
+    animator's ``local_rotations_many(times)`` if the caller has it; ``origin_s``: the
+    session time of the input's start)."""
     if local is None:
         local = animator.local_rotations_many(times)
     poses = animator.poses(times, local)
@@ -121,6 +127,7 @@ def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None =
         string_vibration={
             s: np.array([p.string_vibration.get(s, 0.0) for p in poses]) for s in BASS_STRINGS
         },
+        origin_s=origin_s,
     )
 
 
@@ -218,7 +225,7 @@ def export_performance(
     if animator is not None:
         local = animator.local_rotations_many(times)
         if g is not None:
-            outputs += write_gltf(sample(animator, times, local), g)
+            outputs += write_gltf(sample(animator, times, local, src.start_s), g)
         if b is not None:
             outputs += performance_to_bvh(animator, t0, t1, fps, b, local)
     if m is not None:

@@ -92,7 +92,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="show the heads-up display (tempo, bar.beat, chord) from the start; key H toggles it",
     )
     parser.add_argument(
-        "--plan-log", default=None, metavar="FILE.jsonl", help="write planned notes"
+        "--plan-log",
+        default=None,
+        metavar="FILE.jsonl",
+        help="write planned notes (times from the jam's start; session_time: Unix seconds)",
     )
     parser.add_argument(
         "--duration",

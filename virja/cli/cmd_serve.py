@@ -87,7 +87,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--plan-log",
         metavar="FILE.jsonl",
-        help="write each planned note as one JSON object per line",
+        help="write each planned note as one JSON object per line; times in seconds from "
+        "the first datagram received (the start of a --record), session_time in Unix seconds",
     )
     p.add_argument(
         "--key-file", metavar="FILE", help="HMAC key: drop unsigned, forged and replayed datagrams"

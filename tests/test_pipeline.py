@@ -34,7 +34,7 @@ def test_a_file_gets_its_track_names_tempo_map_and_the_tables_as_they_are() -> N
     planned = run_schedule(perf, src.schedule)
     assert len(planned) == src.note_count == 219
     logged = [json.loads(line) for line in log.getvalue().splitlines()]
-    assert logged == [p.to_json() for p in planned]  # the plan log is the plan
+    assert logged == [p.to_log_json(0.0) for p in planned]  # the plan log is the plan
 
 
 def test_a_file_plays_every_note_the_offline_planner_plays() -> None:

@@ -98,3 +98,14 @@ def test_demo_routes_bass_and_drums_and_ignores_the_piano() -> None:
     assert not any(ev.channel == 0 for _, ev in routed)
     report = "\n".join(r.report())
     assert "'Piano'" in report and "not the band's" in report
+
+
+def test_the_report_counts_one_note_as_one_note() -> None:
+    r = Router()
+    r.route(NoteOn(0.0, 9, 38, 100))
+    for n in range(2):
+        r.route(NoteOn(0.1 * n, 0, 60, 90))
+    assert r.report() == [
+        "channel 1: 2 notes -> not the band's (ignored)",
+        "channel 10: 1 note -> drummer",
+    ]

@@ -74,7 +74,9 @@ def build_performance(
     names, the planner its tempo map, and a recording's RTP-MIDI notes (played at
     once, as live) get the shortest strokes.  ``animate`` gives it a
     :class:`~virja.motion.band.BandAnimator` (poses in this process); ``animator``
-    any other :class:`~virja.session.PlanSink` (the live outputs' fan-out).
+    any other :class:`~virja.session.PlanSink` (the live outputs' fan-out).  Times
+    in the plan log and messages count from the input's start; without ``src`` from
+    the first datagram (or note) unless the caller sets ``origin_s``.
     """
     from virja.plan.planner import OnlinePlanner
 
@@ -96,4 +98,7 @@ def build_performance(
         planner=OnlinePlanner(settings.tables(), tempo=tempo),
         animator=animator,
         plan_log=plan_log,
+        # the session time users call 0: the input's start (a recording's first packet);
+        # live, the first datagram's arrival (serve's Daemon.arrived) or the jam's start
+        origin_s=src.start_s if src is not None else None,
     )

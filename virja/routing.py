@@ -237,7 +237,7 @@ class Router:
                     f" (named as a bass part; its GM program {program + 1} is not a bass;"
                     " [routing] names_over_programs = false to leave it)"
                 )
-            lines.append(f"{where}: {n} notes -> {who}")
+            lines.append(f"{where}: {n} note{'' if n == 1 else 's'} -> {who}")
         return lines
 
 

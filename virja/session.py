@@ -8,8 +8,10 @@ offline: exact 1/fps steps):
     perf.advance(now_s=t)          # commit motions that have started
     perf.pose(t)                   # what to draw at t
 
-The plan log (``--plan-log``) gets one JSON object per planned note, exactly
-as ``virja plan --json`` prints it, written and flushed as notes are committed.
+The plan log (``--plan-log``) gets one JSON object per planned note, as
+``virja plan --json`` prints it plus ``session_time`` (``PlannedNote.to_log_json``),
+written and flushed as notes are committed.  Its times count from ``origin_s``, the
+session time of the input's start (docs/architecture.md, "One time base").
 """
 
 from __future__ import annotations
@@ -57,9 +59,14 @@ class Performance:
         planner: OnlinePlanner,
         animator: PlanSink | None = None,
         plan_log: IO[str] | None = None,
+        origin_s: float | None = 0.0,
     ) -> None:
         self.router = router
         self.planner = planner
+        # the session time users call 0: a MIDI file's start (0), a recording's first
+        # packet; None until :meth:`mark_origin` (serve: the first datagram received)
+        self._origin_s: float | None = None
+        self.origin_s = origin_s
         self.animator = animator
         setter = getattr(animator, "set_articulations", None)
         if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
@@ -75,6 +82,21 @@ class Performance:
         strings = getattr(animator, "use_bass_strings", None)
         if strings is not None:  # the bassist plays (and shows) the strings of the tuning
             strings(tuple(name for name, _ in planner.config.bass.strings))
+
+    @property
+    def origin_s(self) -> float | None:
+        return self._origin_s
+
+    @origin_s.setter
+    def origin_s(self, session_s: float | None) -> None:
+        self._origin_s = session_s
+        if session_s is not None and hasattr(self.planner, "origin_s"):
+            self.planner.origin_s = session_s  # its messages count from there too
+
+    def mark_origin(self, session_s: float) -> None:
+        """The input starts at ``session_s`` unless its start is known already."""
+        if self.origin_s is None:
+            self.origin_s = session_s
 
     def feed(self, event: Event, *, now_s: float) -> Performer | None:
         """An event has become known at ``now_s``; returns the performer it went to."""
@@ -125,13 +147,15 @@ class Performance:
         return self._commit(self.planner.flush())
 
     def _commit(self, notes: list[PlannedNote]) -> list[PlannedNote]:
+        if notes and self.origin_s is None:  # no datagram marked it: the first note's motion
+            self.mark_origin(min(p.start for p in notes))
         for p in notes:
             for tap in self.planned_taps:
                 tap(p)
             if self.animator is not None:
                 self.animator.add_planned(p)
             if self.plan_log is not None:
-                self._log(json.dumps(p.to_json()) + "\n")
+                self._log(json.dumps(p.to_log_json(self.origin_s or 0.0)) + "\n")
             if self.keep_planned:
                 self.planned.append(p)
             self.counts["planned"] += 1

@@ -14,7 +14,7 @@ import mido
 import pytest
 
 from tests.conftest import save_midi
-from virja.plan.types import JSON_KEYS
+from virja.plan.types import LOG_KEYS
 from virja.rmcp.pcap import read_capture
 
 M = mido.Message
@@ -103,7 +103,12 @@ def test_send_serve_record_replay_give_one_plan(tmp_path: Path) -> None:
     assert "0 rejected" in out and "dropped on arrival, never planned: 0" in out, out
     assert "0 dropped by the scheduler" in out, out
     live = [json.loads(line) for line in plan_live.read_text().splitlines()]
-    assert all(tuple(obj) == JSON_KEYS for obj in live)
+    assert all(tuple(obj) == LOG_KEYS for obj in live)
+    # times from the first datagram (the recording's first packet), session time beside
+    first = min(d.time_us for d in read_capture(pcap, port=None).datagrams) / 1e6
+    assert min(o["start"] for o in live) >= 0.0 and max(o["time"] for o in live) < 10.0
+    for o in live:
+        assert abs(o["session_time"] - o["time"] - first) < 2e-6
     # 4 bass notes, 16 drum notes (8 snare, 4 of them doubled by a hi-hat... all band notes)
     assert sorted(o["performer"] for o in live).count("bass") == 4
     assert sorted(o["performer"] for o in live).count("drums") == 12

@@ -130,7 +130,7 @@ def test_node_rtpmidi_notes_are_planned_once_recorded_replayed_and_drawn(tmp_pat
     assert Counter((p["channel"], p["note"]) for p in planned) == both  # each once
     first_s, last_s = sent[0]["sent_us"] / 1e6, sent[-1]["sent_us"] / 1e6
     for p in planned:  # played at once: on arrival, the impact a short stroke later
-        assert first_s - 0.01 <= p["time"] <= last_s + 1.0
+        assert first_s - 0.01 <= p["session_time"] <= last_s + 1.0
         assert 0 < p["impact"] - p["time"] <= 0.1
 
     replay_log = tmp_path / "replay.jsonl"

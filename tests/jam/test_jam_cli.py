@@ -84,7 +84,8 @@ def test_missing_port_exits_non_zero_without_traceback(
 
 @pytest.mark.jack
 def test_headless_jam_plans_the_keys_played(keyboard: JackKeyboard, tmp_path: Path) -> None:
-    """Bass keys and channel 10 become planned motions; their time is Unix time on arrival."""
+    """Bass keys and channel 10 become planned motions; their time counts from the jam's
+    start, their session_time is Unix time on arrival."""
     log = tmp_path / "jam.jsonl"
     argv = [
         "jam",
@@ -112,4 +113,5 @@ def test_headless_jam_plans_the_keys_played(keyboard: JackKeyboard, tmp_path: Pa
     planned = [json.loads(line) for line in log.read_text().splitlines()]
     assert sorted((p["performer"], p["note"]) for p in planned) == [("bass", 40), ("drums", 38)]
     for p in planned:
-        assert before - 1.0 <= p["time"] <= after + 1.0  # Unix seconds, not seconds from start
+        assert before - 1.0 <= p["session_time"] <= after + 1.0  # Unix seconds
+        assert 0.0 <= p["time"] <= 1.5 + 1.0  # seconds from the jam's start

@@ -49,4 +49,5 @@ def test_rtp_midi_keys_are_planned_like_keyboard_keys(
     # E2 below the split: bass; the snare on channel 10; C5 is the pianist's own
     assert sorted((p["performer"], p["note"]) for p in planned) == [("bass", 40), ("drums", 38)]
     for p in planned:
-        assert before - 0.5 <= p["time"] <= before + 2.0
+        assert before - 0.5 <= p["session_time"] <= before + 2.0
+        assert 0.0 <= p["time"] <= 3.0 + 1.0  # from the jam's start

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from virja.plan.types import JSON_KEYS, PlannedNote
+from virja.plan.types import JSON_KEYS, LOG_KEYS, PlannedNote
 from virja.vocab import DrumStroke
 
 P = PlannedNote(
@@ -46,4 +46,37 @@ def test_from_json_rejects_missing_keys() -> None:
     data = P.to_json()
     del data["cost"]
     with pytest.raises(ValueError, match="cost"):
+        PlannedNote.from_json(data)
+
+
+# a recording's times inside are Unix seconds; its JSON counts from its first packet
+ORIGIN = 1_795_393_538.25
+LIVE = PlannedNote(
+    **{**P.__dict__, "time": ORIGIN + 1.0, "start": ORIGIN + 0.8, "impact": ORIGIN + 1.0}
+)
+
+
+def test_json_times_count_from_the_inputs_start() -> None:
+    data = LIVE.to_json(ORIGIN)
+    assert (data["time"], data["start"], data["impact"]) == (1.0, 0.8, 1.0)
+    assert tuple(data) == JSON_KEYS  # plan --json: no other key
+    assert PlannedNote.from_json(data, ORIGIN) == LIVE
+
+
+def test_a_midi_files_json_is_its_own_times() -> None:
+    """Origin 0: the times as they were (MIDI plans stay byte-identical)."""
+    assert P.to_json(0.0) == P.to_json()
+    assert P.to_json()["time"] == 1.0 and P.to_json()["start"] == 0.8
+
+
+def test_the_plan_log_keeps_session_time_in_its_own_field() -> None:
+    line = LIVE.to_log_json(ORIGIN)
+    assert tuple(line) == LOG_KEYS == (*JSON_KEYS, "session_time")
+    assert line["time"] == 1.0 and line["session_time"] == ORIGIN + 1.0
+    assert PlannedNote.from_json(line) == LIVE  # session_time gives the origin back
+
+
+def test_from_json_rejects_an_unknown_key() -> None:
+    data = {**P.to_json(), "origin": 3.0}
+    with pytest.raises(ValueError, match="unexpected \\['origin'\\]"):
         PlannedNote.from_json(data)

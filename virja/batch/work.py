@@ -48,7 +48,9 @@ def _make_plan(src: PerformanceInput, out: Path, settings: BatchSettings) -> lis
     perf = build_performance(settings.performance, src)
     planned = run_schedule(perf, src.schedule)
     path = out / "plan.jsonl"
-    path.write_text("".join(json.dumps(p.to_json()) + "\n" for p in planned), encoding="utf-8")
+    path.write_text(
+        "".join(json.dumps(p.to_json(src.start_s)) + "\n" for p in planned), encoding="utf-8"
+    )
     return [path]
 
 

@@ -43,13 +43,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--start",
         type=finite_float,
         metavar="SECONDS",
-        help="first sample time (default: early enough for the first motion)",
+        help="first sample, seconds from the input's start (default: early enough for the first motion)",
     )
     p.add_argument(
         "--end",
         type=finite_float,
         metavar="SECONDS",
-        help="last sample time (default: the last note plus 1.5 s)",
+        help="last sample, seconds from the input's start (default: the last note plus 1.5 s)",
     )
     p.add_argument(
         "--lookahead-beats",

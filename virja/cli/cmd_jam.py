@@ -93,7 +93,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="show the heads-up display (tempo, bar.beat, chord) from the start; key H toggles it",
     )
     parser.add_argument(
-        "--plan-log", default=None, metavar="FILE.jsonl", help="write planned notes"
+        "--plan-log",
+        default=None,
+        metavar="FILE.jsonl",
+        help="write planned notes (times from the jam's start; session_time: Unix seconds)",
     )
     parser.add_argument(
         "--duration",
@@ -199,6 +202,7 @@ def run(args: argparse.Namespace) -> int:
             animate=bool(args.web),  # poses here only for the browser; the window animates itself
             plan_log=log_fh,
         )
+        perf.origin_s = clock.now_s()  # the plan log counts from the jam's start
         # the window draws in its own process (see virja.live.viewer)
         window = None if args.headless else ViewerSpec(size, "virja jam", opts.fps, hud=args.hud)
         outputs = LiveOutputs.open(perf, LiveSettings(window, web_settings(args)), clock.now_s)

@@ -5,7 +5,8 @@ The notes go through the same planner as a live performance: each is revealed
 traffic: when its datagram was captured), and a motion, once started, is never
 changed.  Without --json: an aligned table and a summary (notes per performer,
 total cost, dropped and moved notes).  With --json: one JSON object per line
-per planned note, the keys of virja.plan.PlannedNote.
+per planned note, the keys of virja.plan.PlannedNote.  Times are seconds from the
+start of the input, for a recording from its first packet (as render --at counts).
 
 Example:  virja plan song.mid --lookahead-beats 1
           virja plan session.pcap --json > plan.jsonl
@@ -167,14 +168,14 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         try:
             for p in planned:
-                print(json.dumps(p.to_json()))
+                print(json.dumps(p.to_json(src.start_s)))
         except BrokenPipeError:  # `virja plan --json ... | head`
             return 0
         return 0
     if src.start_s:
         print(
-            f"times: seconds from the recording's start (session time {src.start_s:.6f} s; "
-            "--json gives session time)"
+            f"times: seconds from the recording's start (its first packet, session time "
+            f"{src.start_s:.6f} s; a plan log's session_time gives each note's)"
         )
     for line in _table(planned, src.start_s):
         print(line)

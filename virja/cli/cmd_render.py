@@ -91,19 +91,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--at",
         type=finite_float,
         metavar="SECONDS",
-        help="render only the frame at this time (with a .png OUT)",
+        help="render only the frame at this time, seconds from the input's start "
+        "(a recording's first packet; with a .png OUT)",
     )
     p.add_argument(
         "--start",
         type=finite_float,
         metavar="SECONDS",
-        help="first frame time (default: early enough for the first motion)",
+        help="first frame, seconds from the input's start (default: early enough for "
+        "the first motion)",
     )
     p.add_argument(
         "--end",
         type=finite_float,
         metavar="SECONDS",
-        help="last frame time (default: the end plus 1.5 s)",
+        help="last frame, seconds from the input's start (default: the end plus 1.5 s)",
     )
     p.add_argument(
         "--samples",
@@ -253,7 +255,8 @@ def render_span(src: PerformanceInput, request: RenderRequest) -> tuple[float, f
     fps = request.frames.fps
     if (t1 - t0) * fps > MAX_FRAMES:  # e.g. a recording with datagrams years apart
         raise ConfigError(
-            f"the span {t0:.3f} .. {t1:.3f} s is {(t1 - t0) * fps:.0f} frames, more than "
+            f"the span {t0 - base:.3f} .. {t1 - base:.3f} s is {(t1 - t0) * fps:.0f} "
+            f"frames, more than "
             f"{MAX_FRAMES:,}; pick a part with --start and --end"
         )
     return t0, t1
@@ -340,7 +343,10 @@ def choose_camera(name: str, src: object, perf: object) -> Camera | FollowCamera
     shots = plan_shots(notes, *src.default_span())
     print(
         f"follow camera: {len(shots)} shots: "
-        + ", ".join(f"{s.name} {s.start_s:.1f}-{s.end_s:.1f} s" for s in shots[:8])
+        + ", ".join(  # seconds from the input's start, as --at counts
+            f"{s.name} {s.start_s - src.start_s:.1f}-{s.end_s - src.start_s:.1f} s"
+            for s in shots[:8]
+        )
         + (" ..." if len(shots) > 8 else "")
     )
     return FollowCamera(shots)

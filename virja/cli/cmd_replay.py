@@ -50,7 +50,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--key-file", metavar="FILE", help="HMAC key, as the live daemon had it")
     p.add_argument(
-        "--plan-log", metavar="FILE.jsonl", help="write the plan, one JSON object per note"
+        "--plan-log",
+        metavar="FILE.jsonl",
+        help="write the plan, one JSON object per note (times from the recording's first "
+        "packet; session_time: Unix seconds)",
     )
     p.add_argument("--headless", action="store_true", help="draw nothing: plan and summary only")
     p.add_argument(

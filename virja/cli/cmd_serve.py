@@ -91,7 +91,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--plan-log",
         metavar="FILE.jsonl",
-        help="write each planned note as one JSON object per line",
+        help="write each planned note as one JSON object per line; times in seconds from "
+        "the first datagram received (the start of a --record), session_time in Unix seconds",
     )
     p.add_argument(
         "--key-file", metavar="FILE", help="HMAC key: drop unsigned, forged and replayed datagrams"
@@ -150,6 +151,11 @@ class Daemon:
     viewer: Any = None
     late_notes: int = 0
     started_s: float = field(default_factory=time.monotonic)
+
+    def arrived(self, now_us: int) -> None:
+        """A datagram arrived: the first is the start of the session (what a recording
+        of it starts with), from which the plan log counts its times."""
+        self.perf.mark_origin(now_us / 1e6)
 
     def on_events(self, received: list[Any], now_s: float) -> None:
         from virja.events import NoteOn
@@ -335,6 +341,7 @@ async def serve(args: argparse.Namespace) -> int:
         raise ConfigError(f"--fps must be 1-1000, got {args.fps:g}")
     daemon = Daemon(perf=perf, receiver=receiver, clock=clock)
     protocol = RmcpProtocol(receiver, clock, daemon.on_events)
+    protocol.on_arrival = daemon.arrived
     transport = await open_stamped_listener(host, port, protocol, clock, group=args.group)
     bound = transport.get_extra_info("sockname")
     rtp = None

@@ -66,6 +66,7 @@ async def start_serve(args: argparse.Namespace, clock: Any, daemon: Any) -> Any:
             daemon.on_events(received, now_s)
 
     listener = Listener(clock, on_messages, config=HostConfig(name=args.rtp_midi_name))
+    listener.on_arrival = daemon.arrived  # the first datagram is the session's start
     bound = await listener.start(*where)
     if args.announce:
         try:

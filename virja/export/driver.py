@@ -96,9 +96,15 @@ def check_request(
         _check_out(musicxml, "--musicxml", (".musicxml", ".xml"))
 
 
-def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None = None) -> Sampled:
+def sample(
+    animator: BandAnimator,
+    times: np.ndarray,
+    local: np.ndarray | None = None,
+    origin_s: float = 0.0,
+) -> Sampled:
     """The band at ``times`` (sorted), as arrays for the glTF writer (``local``: the
-    animator's ``local_rotations_many(times)`` if the caller has it)."""
+    animator's ``local_rotations_many(times)`` if the caller has it; ``origin_s``: the
+    session time of the input's start)."""
     if local is None:
         local = animator.local_rotations_many(times)
     poses = animator.poses(times, local)
@@ -121,6 +127,7 @@ def sample(animator: BandAnimator, times: np.ndarray, local: np.ndarray | None =
         string_vibration={
             s: np.array([p.string_vibration.get(s, 0.0) for p in poses]) for s in BASS_STRINGS
         },
+        origin_s=origin_s,
     )
 
 
@@ -171,8 +178,9 @@ def export_performance(
     - ``gltf``: ``.glb`` or ``.gltf`` (+ ``.bin``), both figures and the instruments animated;
     - ``bvh``: ``NAME.bvh`` writes ``NAME_drums.bvh`` and ``NAME_bass.bvh``;
     - ``musicxml``: ``.musicxml`` (MusicXML 4.0, uncompressed);
-    - ``fps``: motion sampling rate; ``start_s``/``end_s``: the span in session
-      seconds (default: from the first motion to the last note plus 1.5 s);
+    - ``fps``: motion sampling rate; ``start_s``/``end_s``: the span in seconds from
+      the input's start, a recording's first packet (default: from the first motion to
+      the last note plus 1.5 s);
     - ``config``: a virja TOML file ([routing], [plan]); ``routing`` overrides its [routing]
       and ``plan_config`` (already parsed, as `virja batch` hands it to its workers) its [plan].
 
@@ -201,17 +209,21 @@ def export_performance(
     assert animator is None or isinstance(animator, BandAnimator)
     planned = run_schedule(perf, src.schedule)
     t0, t1 = src.default_span()
-    t0 = t0 if start_s is None else start_s
-    t1 = t1 if end_s is None else end_s
+    # start_s/end_s count from the input's start (a recording's first packet), as render's
+    t0 = t0 if start_s is None else src.start_s + start_s
+    t1 = t1 if end_s is None else src.start_s + end_s
     if t1 < t0:
-        raise ConfigError(f"nothing to export: end {t1:.3f} s is before start {t0:.3f} s")
+        raise ConfigError(
+            f"nothing to export: end {t1 - src.start_s:.3f} s is before start "
+            f"{t0 - src.start_s:.3f} s"
+        )
     n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
     times = t0 + np.arange(n) / fps
     outputs: list[Path] = []
     if animator is not None:
         local = animator.local_rotations_many(times)
         if g is not None:
-            outputs += write_gltf(sample(animator, times, local), g)
+            outputs += write_gltf(sample(animator, times, local, src.start_s), g)
         if b is not None:
             outputs += performance_to_bvh(animator, t0, t1, fps, b, local)
     if m is not None:
@@ -232,4 +244,5 @@ def score_of(
         beats=beats,
         time_signatures=list(src.midi.time_signatures) if src.midi is not None else [],
         title=src.path.stem,
+        origin_s=src.start_s,  # no BEATs in a recording: its beats count from its start
     )

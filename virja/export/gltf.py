@@ -24,7 +24,9 @@ Layout of the file (names are stable; tools may look them up):
   a time, as Blender does, show the whole band moving).
 
 Metres, y up, the audience at +z (glTF's default frame: front is +z).
-Animation time 0 is the session time ``extras.virja.t0_s`` of the scene.
+Animation time 0 is ``extras.virja.t0_s`` of the scene, seconds from the input's
+start, whose session time is ``extras.virja.origin_s`` (0 for a MIDI file; a
+recording's first packet, Unix seconds).
 """
 
 from __future__ import annotations
@@ -81,7 +83,8 @@ class Sampled:
     - ``kick_down``: (m,) 0 (pedal up) .. 1 (pressed), from the right foot;
     - ``string_vibration``: string -> (m,) metres;
     - ``hihat_down``: (m,) 0 (pedal up) .. 1 (pressed), from the left foot (None:
-      ``1 - hihat_open``).
+      ``1 - hihat_open``);
+    - ``origin_s``: the session time of the input's start (what users call 0).
     """
 
     times: F64
@@ -92,6 +95,7 @@ class Sampled:
     kick_down: F64
     string_vibration: dict[str, F64]
     hihat_down: F64 | None = None
+    origin_s: float = 0.0
 
 
 # ---------------------------------------------------------------- unit meshes
@@ -703,7 +707,13 @@ def build_gltf(s: Sampled, geo: Geometry = GEOMETRY) -> GltfBuilder:
         {
             "name": "virja band",
             "nodes": [drums, bass, stage],
-            "extras": {"virja": {"t0_s": float(s.times[0]), "fps": _fps(s.times)}},
+            "extras": {
+                "virja": {
+                    "t0_s": round(float(s.times[0]) - s.origin_s, 6),
+                    "origin_s": s.origin_s,
+                    "fps": _fps(s.times),
+                }
+            },
         }
     ]
     return b

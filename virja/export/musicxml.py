@@ -108,8 +108,11 @@ class Score:
         beats: list[Beat],
         time_signatures: list[tuple[float, int, int]],
         title: str = "virja",
+        origin_s: float = 0.0,
     ) -> Score:
-        grid = _Grid(tempo, beats)
+        """``origin_s``: the session time of the input's start (a recording's first
+        packet), beat 0 when neither a tempo map nor BEATs give the beats."""
+        grid = _Grid(tempo, beats, origin_s)
         marks = [(grid.sixteenth(p.time), p) for p in notes]
         lo = min((m for m, _ in marks), default=0)
         hi = max((m for m, _ in marks), default=0)
@@ -139,8 +142,9 @@ class Score:
 class _Grid:
     """Session seconds -> sixteenths of the quarter-note beat, from a tempo map or BEATs."""
 
-    def __init__(self, tempo: Tempo | None, beats: list[Beat]) -> None:
+    def __init__(self, tempo: Tempo | None, beats: list[Beat], origin_s: float = 0.0) -> None:
         self.tempo = tempo
+        self.origin_s = origin_s
         self.beat_times = [b.time_s for b in beats]
         self.beats = beats
         self.origin = 0
@@ -158,7 +162,7 @@ class _Grid:
         bt = self.beat_times
         if len(bt) < 2:
             spb = self.tempo.seconds_per_beat_at(t) if self.tempo is not None else 0.5
-            return (t - (bt[0] if bt else 0.0)) / spb
+            return (t - (bt[0] if bt else self.origin_s)) / spb
         i = min(max(bisect.bisect_right(bt, t) - 1, 0), len(bt) - 2)
         return i + (t - bt[i]) / (bt[i + 1] - bt[i])
 

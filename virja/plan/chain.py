@@ -90,13 +90,15 @@ class Ledger:
         self.moved: deque[MovedNote] = deque(maxlen=MAX_REPORTED)
         self.counts: Counter[str] = Counter()
         self.unplayed: Counter[str] = Counter()  # per instrument: not a kit drummer's
+        # for messages only: times are said from the input's start (Performance sets it)
+        self.origin_s = 0.0
 
     def drop(self, rec: Held, reason: DropReason) -> None:
         log.info(
             "dropped %s note %d at %.3f s: %s",
             rec.performer,
             rec.note.note,
-            rec.note.time_s,
+            rec.note.time_s - self.origin_s,
             reason,
         )
         self.dropped.append(DroppedNote(rec.performer, rec.note, reason))

@@ -171,6 +171,15 @@ class OnlinePlanner:
         return self._ledger.report()
 
     @property
+    def origin_s(self) -> float:
+        """For messages only: times are said from the input's start (Performance sets it)."""
+        return self._ledger.origin_s
+
+    @origin_s.setter
+    def origin_s(self, value: float) -> None:
+        self._ledger.origin_s = value
+
+    @property
     def pending_count(self) -> int:
         return sum(c.pending_count for c in self._chains)
 

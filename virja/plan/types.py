@@ -2,7 +2,9 @@
 
 ``PlannedNote`` is the contract between the planner and the animator (and the
 ``virja plan --json`` / plan-log format): its fields, in order, are exactly the
-JSON keys.  All times are session seconds (``float``).
+JSON keys.  All times inside are session seconds (``float``); in JSON they are
+seconds from the input's start (docs/architecture.md, "One time base"), and the
+plan log adds ``session_time`` (:data:`LOG_KEYS`).
 """
 
 from __future__ import annotations
@@ -40,6 +42,9 @@ JSON_KEYS: tuple[str, ...] = (
     "cost",
     "late",
 )
+# the plan log's line: the note as ``virja plan --json`` prints it, then its session time
+LOG_KEYS: tuple[str, ...] = (*JSON_KEYS, "session_time")
+_TIMES = ("time", "start", "impact")
 
 
 @dataclass(frozen=True)
@@ -70,27 +75,46 @@ class PlannedNote:
     cost: float
     late: bool
 
-    def to_json(self) -> dict[str, Any]:
-        """A dict with exactly :data:`JSON_KEYS`, in that order; times rounded to the
-        microsecond (the wire's resolution), so logs carry no float noise; the channel
-        1-16 (10 for drums) as every message and option names it (it is 0-15 inside)."""
+    def to_json(self, origin_s: float = 0.0) -> dict[str, Any]:
+        """A dict with exactly :data:`JSON_KEYS`, in that order; ``time``, ``start`` and
+        ``impact`` in seconds from ``origin_s``, the session time of the input's start
+        (0 for a MIDI file: its times are already from its start; a recording's first
+        packet), rounded to the microsecond (the wire's resolution), so logs carry no
+        float noise; the channel 1-16 (10 for drums) as every message and option names
+        it (it is 0-15 inside)."""
         out = {key: getattr(self, key) for key in JSON_KEYS}
         out["motion"] = self.motion.name
-        for key in ("time", "start", "impact"):
-            out[key] = round(out[key], 6)
+        for key in _TIMES:  # the session time's microsecond, then from the origin
+            out[key] = round(round(out[key], 6) - origin_s, 6)
         out["channel"] = self.channel + 1  # 1-16, as musicians and every message count
         return out
 
+    def to_log_json(self, origin_s: float = 0.0) -> dict[str, Any]:
+        """A plan-log line, :data:`LOG_KEYS`: :meth:`to_json` and ``session_time``, the
+        session time at which the note sounds (Unix seconds for live and recorded
+        sessions), so ``session_time - time`` is the origin."""
+        out = self.to_json(origin_s)
+        out["session_time"] = round(self.time, 6)
+        return out
+
     @classmethod
-    def from_json(cls, data: dict[str, Any]) -> PlannedNote:
-        """Inverse of :meth:`to_json`; raises ``ValueError`` on missing or extra keys."""
+    def from_json(cls, data: dict[str, Any], origin_s: float = 0.0) -> PlannedNote:
+        """Inverse of :meth:`to_json` (times from ``origin_s``) and of :meth:`to_log_json`
+        (its ``session_time`` gives the origin; ``origin_s`` is then not used); raises
+        ``ValueError`` on missing or extra keys."""
         keys = set(data)
-        if keys != set(JSON_KEYS):
+        if keys != set(JSON_KEYS) and keys != set(LOG_KEYS):
             missing = sorted(set(JSON_KEYS) - keys)
-            extra = sorted(keys - set(JSON_KEYS))
+            extra = sorted(keys - set(LOG_KEYS))
             raise ValueError(f"planned note keys wrong: missing {missing}, unexpected {extra}")
+        if "session_time" in data:
+            origin_s = float(data["session_time"]) - float(data["time"])
+        # back on the session clock, to the microsecond the JSON holds
+        time, start, impact = (
+            round(float(data[k]) + origin_s, 6) if origin_s else float(data[k]) for k in _TIMES
+        )
         return cls(
-            time=float(data["time"]),
+            time=time,
             performer=data["performer"],
             channel=int(data["channel"]) - 1,
             note=int(data["note"]),
@@ -100,8 +124,8 @@ class PlannedNote:
             string=data["string"],
             fret=None if data["fret"] is None else int(data["fret"]),
             motion=MotionKey.parse(str(data["motion"])),
-            start=float(data["start"]),
-            impact=float(data["impact"]),
+            start=start,
+            impact=impact,
             cost=float(data["cost"]),
             late=bool(data["late"]),
         )

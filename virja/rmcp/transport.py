@@ -172,6 +172,7 @@ class RmcpProtocol(asyncio.DatagramProtocol):
         self.clock = clock
         self.on_events = on_events
         self.recorder = recorder
+        self.on_arrival: Callable[[int], None] | None = None  # each datagram's arrival (µs)
         self.transport: asyncio.DatagramTransport | None = None
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
@@ -184,6 +185,8 @@ class RmcpProtocol(asyncio.DatagramProtocol):
     def receive(self, data: bytes, addr: Any, *, now_us: int) -> None:
         """One datagram that arrived at ``now_us`` (session clock; the kernel's
         stamp of its arrival where :mod:`virja.rmcp.stamped` has one)."""
+        if self.on_arrival is not None:
+            self.on_arrival(now_us)
         if self.recorder is not None:
             try:  # PcapWriter stops itself on a disk fault; anything else stops it here
                 self.recorder.write(data, addr, time_us=now_us)

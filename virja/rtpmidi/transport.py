@@ -78,6 +78,7 @@ class Listener:
         self.on_messages = on_messages
         self.host = SessionHost(config)
         self.recorder = recorder
+        self.on_arrival: Callable[[int], None] | None = None  # each datagram's arrival (µs)
         self.address: tuple[str, int] = ("", 0)
         self.announcement: Any = None  # an mDNS registration, withdrawn on close
         self.bound: tuple[str, int] = ("", 0)
@@ -102,6 +103,8 @@ class Listener:
 
     def received(self, data: bytes, addr: Any, channel: Channel) -> None:
         now_us = self.clock.now_us()
+        if self.on_arrival is not None:
+            self.on_arrival(now_us)
         if self.recorder is not None:
             port = self.address[1] + (1 if channel is Channel.DATA else 0)
             self.recorder.write(data, addr, time_us=now_us, dst=(self.address[0], port))

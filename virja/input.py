@@ -148,7 +148,8 @@ def rtp_midi_report(rtp: Any) -> list[str]:
     st = rtp.stats
     return [
         f"RTP-MIDI on ports {rtp.control_port}/{rtp.control_port + 1}: "
-        f"{st.sessions_opened} sessions, {st.messages} MIDI messages, "
+        f"{st.sessions_opened} session{'' if st.sessions_opened == 1 else 's'}, "
+        f"{st.messages} MIDI message{'' if st.messages == 1 else 's'}, "
         f"drops {dict(st.dropped) or 'none'}"
     ]
 

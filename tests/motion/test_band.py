@@ -13,6 +13,7 @@ from virja.geometry import GEOMETRY
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings
+from virja.motion.drummer_hands import HandSettings
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
 from virja.vocab import BASS_STRINGS, BassPluck, DrumStroke
@@ -24,6 +25,7 @@ DRUM_MOTIONS = [f"{p}_{h}" for p in HAND_PIECES for h in ("left_hand", "right_ha
 ]
 # the limb layer alone: these tests check the clips and their connections
 STILL = BodySettings.still()
+CLIPS = HandSettings.clips()  # the hands as their clips move them (not from where they are)
 TOL = 0.01  # 1 cm
 
 
@@ -37,7 +39,7 @@ def test_library_has_every_basic_motion(library: MotionLibrary) -> None:
 @pytest.mark.parametrize("motion", DRUM_MOTIONS)
 def test_drum_stroke_contact_within_1cm_at_impact(library: MotionLibrary, motion: str) -> None:
     clip = library[motion]
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     p = drum(motion, 1.0, 1.0 + clip.impact_s)
     a.add_planned(p)
     assert contact_distance(a, p, p.impact)[0] < TOL
@@ -46,7 +48,7 @@ def test_drum_stroke_contact_within_1cm_at_impact(library: MotionLibrary, motion
 @pytest.mark.parametrize("string", BASS_STRINGS)
 def test_every_fret_contact_within_1cm_at_impact(library: MotionLibrary, string: str) -> None:
     for fret in range(0, 21):
-        a = BandAnimator(library, body=STILL)
+        a = BandAnimator(library, body=STILL, hands=CLIPS)
         p = bass(string, fret, 1.0, 1.2)
         a.add_planned(p)
         pluck, fretting = contact_distance(a, p, p.impact)
@@ -58,7 +60,7 @@ def test_every_fret_contact_within_1cm_at_impact(library: MotionLibrary, string:
 @pytest.mark.parametrize("prep_s", [0.06, 0.2, 0.6])
 def test_time_warp_keeps_start_and_impact(library: MotionLibrary, prep_s: float) -> None:
     """The clip's first frame shows at ``start`` and the contact lands at ``impact``."""
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     p = drum("snare_right_hand", 2.0, 2.0 + prep_s)
     a.add_planned(p)
     idle = library["idle_drums"].rotations[0]
@@ -93,9 +95,9 @@ def test_crossfade_only_inside_the_overlap(library: MotionLibrary) -> None:
     pa = drum("snare_left_hand", 1.0, 1.25)
     pb = drum("tom_high_left_hand", 1.35, 1.65)
     only_a, only_b, both = (
-        BandAnimator(library, body=STILL),
-        BandAnimator(library, body=STILL),
-        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
     )
     only_a.add_planned(pa)
     only_b.add_planned(pb)
@@ -124,9 +126,9 @@ def test_crossfade_weights_go_linearly_from_a_to_b(library: MotionLibrary) -> No
     pa = drum("snare_left_hand", 1.0, 1.25)
     pb = drum("tom_high_left_hand", 1.35, 1.65)
     a, oa, ob = (
-        BandAnimator(library, body=STILL),
-        BandAnimator(library, body=STILL),
-        BandAnimator(library, body=STILL),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
     )
     for an, ps in ((a, (pa, pb)), (oa, (pa,)), (ob, (pb,))):
         for p in ps:
@@ -143,7 +145,7 @@ def test_fast_repeat_keeps_both_impacts(library: MotionLibrary) -> None:
     """B starts before A's impact: the connection waits for A's impact, both land."""
     pa = drum("snare_right_hand", 1.0, 1.2)
     pb = drum("snare_right_hand", 1.1, 1.3)
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     a.add_planned(pa)
     a.add_planned(pb)
     assert contact_distance(a, pa, pa.impact)[0] < TOL
@@ -162,7 +164,10 @@ def test_limb_masks_are_independent(
     library: MotionLibrary, performer: str, limb: str, note: object
 ) -> None:
     """A motion of one limb changes that limb's joints only (and never the other figure)."""
-    base, moved = BandAnimator(library, body=STILL), BandAnimator(library, body=STILL)
+    base, moved = (
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+    )
     base.add_planned(drum("snare_left_hand", 1.0, 1.25))
     moved.add_planned(drum("snare_left_hand", 1.0, 1.25))
     moved.add_planned(note)  # type: ignore[arg-type]
@@ -179,9 +184,9 @@ def test_limb_masks_are_independent(
 def test_bass_hands_are_independent(library: MotionLibrary) -> None:
     """The plucking hand goes where its clip says whatever the fretting hand does (the
     body follows the fretting hand, and the arms are solved again to keep both hands)."""
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     a.add_planned(bass("A", 5, 1.0, 1.2))
-    b = BandAnimator(library, body=STILL)
+    b = BandAnimator(library, body=STILL, hands=CLIPS)
     b.add_planned(bass("A", 0, 1.0, 1.2))  # open string: the right hand alone moves
     tip = SKELETON.index("RightHandEnd")
     for t in np.arange(0.95, 1.6, 0.02):
@@ -192,7 +197,7 @@ def test_bass_hands_are_independent(library: MotionLibrary) -> None:
 def test_soft_stroke_is_smaller_but_still_lands(library: MotionLibrary) -> None:
     heights = []
     for vel in (30, 127):
-        a = BandAnimator(library, body=STILL)
+        a = BandAnimator(library, body=STILL, hands=CLIPS)
         p = drum("snare_right_hand", 1.0, 1.3, velocity=vel)
         a.add_planned(p)
         assert contact_distance(a, p, p.impact)[0] < TOL
@@ -203,7 +208,10 @@ def test_soft_stroke_is_smaller_but_still_lands(library: MotionLibrary) -> None:
 def test_faster_tempo_shortens_the_rebound(library: MotionLibrary) -> None:
     from virja.events import Beat
 
-    slow, fast = BandAnimator(library, body=STILL), BandAnimator(library, body=STILL)
+    slow, fast = (
+        BandAnimator(library, body=STILL, hands=CLIPS),
+        BandAnimator(library, body=STILL, hands=CLIPS),
+    )
     fast.add_beat(Beat(0.0, 0, 1, 4, 0, 250_000))  # 240 bpm
     for a in (slow, fast):
         a.add_planned(drum("snare_right_hand", 1.0, 1.3))
@@ -212,7 +220,7 @@ def test_faster_tempo_shortens_the_rebound(library: MotionLibrary) -> None:
 
 
 def test_kit_state_follows_the_strokes(library: MotionLibrary) -> None:
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     a.add_planned(drum("snare_left_hand", 1.0, 1.25, velocity=127))
     a.add_planned(drum("crash_right_hand", 1.0, 1.4))
     a.add_planned(drum("hihat_left_foot", 1.0, 1.2))
@@ -230,7 +238,7 @@ def test_kit_state_follows_the_strokes(library: MotionLibrary) -> None:
 
 
 def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:
-    p = BandAnimator(library, body=STILL).pose(0.0)
+    p = BandAnimator(library, body=STILL, hands=CLIPS).pose(0.0)
     n = SKELETON.n_joints
     for fig in (p.drums, p.bass):
         assert fig.positions.shape == (n, 3) and fig.rotations.shape == (n, 4)
@@ -243,7 +251,7 @@ def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:
 
 
 def test_forget_before_bounds_memory(library: MotionLibrary) -> None:
-    a = BandAnimator(library, body=STILL)
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
     for i in range(400):
         t = 1.0 + 0.25 * i
         a.add_planned(drum("snare_left_hand" if i % 2 else "snare_right_hand", t - 0.2, t))
@@ -261,9 +269,9 @@ def test_unknown_motion_raises(library: MotionLibrary) -> None:
     note = drum("snare_left_hand", 1.0, 1.2)
     cowbell = replace(note, motion=DrumStroke("cowbell", "left_hand"))  # type: ignore[arg-type]
     with pytest.raises(UnknownMotionError, match="cowbell"):
-        BandAnimator(library, body=STILL).add_planned(cowbell)
+        BandAnimator(library, body=STILL, hands=CLIPS).add_planned(cowbell)
     with pytest.raises(UnknownMotionError, match="pluck_A_fret3"):
-        BandAnimator(library, body=STILL).add_planned(replace(note, motion=BassPluck("A", 3)))
+        BandAnimator(library, body=STILL, hands=CLIPS).add_planned(replace(note, motion=BassPluck("A", 3)))
 
 
 def test_default_library_is_shared() -> None:

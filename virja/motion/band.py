@@ -27,6 +27,7 @@ from virja.geometry import GEOMETRY, Geometry
 from virja.motion.bassist import Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings, DrummerBody
+from virja.motion.drummer_hands import DrummerHands, HandSettings
 from virja.motion.drummer_kit import HihatState, default_articulations
 from virja.motion.hits import Hit, HitTable
 from virja.motion.pose import BandPose, FigurePose
@@ -145,6 +146,7 @@ class BandAnimator:
         geometry: Geometry = GEOMETRY,
         settings: AnimationSettings | None = None,
         body: BodySettings | None = None,
+        hands: HandSettings | None = None,
     ) -> None:
         self.library = library if library is not None else default_library()
         self.geometry = geometry
@@ -163,6 +165,7 @@ class BandAnimator:
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
         self.body = DrummerBody(self._roots[0], geometry, body)
+        self.hands = DrummerHands(self._roots[0], self.idle["drums"].rotations[0], hands)
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
         self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
@@ -231,6 +234,7 @@ class BandAnimator:
                 )
             )
             self._hits.add(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
+            self.hands.add_stroke(limb, p.impact, clip, p.velocity)
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
@@ -284,6 +288,7 @@ class BandAnimator:
         for tl in self.timelines.values():
             tl.forget_before(time_s)
         self.body.forget_before(time_s)
+        self.hands.forget_before(time_s)
         self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
@@ -306,12 +311,21 @@ class BandAnimator:
             loc[_HEAD] = quat.multiply(loc[_HEAD], nod[1])
             for limb in PERFORMER_LIMBS[f]:
                 tl = self.timelines[(f, limb)]
-                if len(tl):
+                if f == "drums" and self._from_hands(limb):
+                    loc[self.hands.joint_index(limb)] = self.hands.local(limb, np.array([time_s]))[
+                        0
+                    ]
+                elif len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
         out[0] = self._body(np.array([time_s]), out[None, 0])[0]
         index, phase = self._beat_phase(time_s)
         out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
+
+    def _from_hands(self, limb: str) -> bool:
+        """Whether the drummer's ``limb`` moves from where it is (virja.motion.drummer_hands)
+        rather than by its time-warped clips."""
+        return self.hands.enabled and self.hands.has_strokes(limb)
 
     def _beat_phase(self, t: float) -> tuple[int, float]:
         """(beat number, phase 0..1 within it) at ``t`` (120 bpm before the first beat)."""
@@ -392,7 +406,9 @@ class BandAnimator:
             loc[:, _HEAD] = quat.multiply(loc[:, _HEAD], nod[:, 1])
             for limb in PERFORMER_LIMBS[f]:
                 tl = self.timelines[(f, limb)]
-                if len(tl):
+                if f == "drums" and self._from_hands(limb):
+                    loc[:, self.hands.joint_index(limb)] = self.hands.local(limb, ts)
+                elif len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
         out[:, 0] = self._body(ts, out[:, 0])
         index, phase = self._beat_phase_many(ts)

@@ -1,0 +1,399 @@
+"""The drummer's hands from where they are (issue 15, deliverable 3).
+
+The authored hand clips all start and end in one ready pose over the snare;
+squeezed into a short lead they sent the wrist 30-50 cm back to the snare and
+out again between two ride strokes.  Here a hand's motion is built from its
+strokes instead, and the clips give only their impact poses (the grip, the
+hand's rotation and the elbow at the impact frame, exact on the instrument):
+
+- **keys**: for each stroke a *backswing* key (the next piece's impact pose
+  with the stick raised) ``down`` seconds before the impact and the impact key
+  itself; after the impact the stick rebounds to a *hover* over the piece just
+  struck and waits there; the hand leaves for the next piece only when it must
+  (``distance / move_speed`` before the backswing key, or at once when the
+  time is short); after ``rest_after_s`` without a stroke it goes to the
+  relaxed ready pose and comes back in time for the next.
+- **lift**: velocity sets the stick tip's height above the surface (not a
+  scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity and
+  at most ``lift_per_s`` times the time since the previous stroke; the stick
+  turns up about the wrist (the wrist itself rises ``wrist_share`` of it), so a
+  soft stroke is a low one and nothing dives under a head or a cymbal.
+- **profiles**: into an impact the stick accelerates (u^2), out of it it
+  decelerates, every other segment eases in and out (smoothstep); the pose
+  is interpolated between keys (grip and elbow lerp, hand rotation slerp).
+- **arm**: each frame the arm is solved by two-bone IK from the fixed shoulder
+  to the wrist, the elbow toward the interpolated authored elbow, the hand at
+  its world rotation.  At the impact key the pose is the clip's own, so contact
+  stays exact.
+
+Everything is vectorised over times; constants in motions/drummer_hands.toml.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from virja.errors import ConfigError
+from virja.motion import quat
+from virja.motion.clip import Clip
+from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
+
+_SK = SKELETON
+HANDS = ("left_hand", "right_hand")
+_SIDE = {"left_hand": "Left", "right_hand": "Right"}
+_UP = np.array([0.0, 1.0, 0.0])
+_SMOOTH, _ACCEL, _DECEL = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class HandSettings:
+    """Constants from motions/drummer_hands.toml (reasons given there)."""
+
+    enabled: bool = True
+    lift_soft_m: float = 0.03
+    lift_loud_m: float = 0.30
+    lift_per_s: float = 1.6
+    hover_m: float = 0.05
+    wrist_share: float = 0.3
+    down_share: float = 0.3
+    down_min_s: float = 0.02
+    down_max_s: float = 0.09
+    rebound_share: float = 0.3
+    rebound_max_s: float = 0.12
+    move_speed_m_s: float = 2.5
+    rest_after_s: float = 2.0
+    rest_move_s: float = 0.5
+
+    @classmethod
+    def clips(cls) -> HandSettings:
+        """The hands as the clips move them (the time-warped authored strokes)."""
+        return cls(enabled=False)
+
+    @classmethod
+    def load(cls, path: Path | None = None) -> HandSettings:
+        if path is None:
+            from virja.resources import motions_dir
+
+            path = motions_dir() / "drummer_hands.toml"
+        if not path.is_file():
+            return cls()
+        where = str(path)
+        try:
+            d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError, OSError) as exc:
+            raise ConfigError(f"{where}: cannot read: {exc}") from None
+        try:
+            lift, time, move = d["lift"], d["time"], d["move"]
+            s = cls(
+                enabled=bool(d.get("enabled", True)),
+                lift_soft_m=float(lift["soft_m"]),
+                lift_loud_m=float(lift["loud_m"]),
+                lift_per_s=float(lift["per_s"]),
+                hover_m=float(lift["hover_m"]),
+                wrist_share=float(lift["wrist_share"]),
+                down_share=float(time["down_share"]),
+                down_min_s=float(time["down_min_s"]),
+                down_max_s=float(time["down_max_s"]),
+                rebound_share=float(time["rebound_share"]),
+                rebound_max_s=float(time["rebound_max_s"]),
+                move_speed_m_s=float(move["speed_m_s"]),
+                rest_after_s=float(move["rest_after_s"]),
+                rest_move_s=float(move["rest_move_s"]),
+            )
+        except KeyError as exc:
+            raise ConfigError(f"{where}: missing key {exc.args[0]!r}") from None
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"{where}: a value has the wrong type: {exc}") from None
+        for name in ("lift_per_s", "move_speed_m_s", "rest_after_s", "rest_move_s", "down_max_s"):
+            v = getattr(s, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ConfigError(f"{where}: {name} must be a finite number > 0, got {v}")
+        return s
+
+
+@dataclass(frozen=True)
+class _Pose:
+    """A hand pose in the still body's frame: grip (3,), hand rotation (4,), elbow
+    relative to the shoulder (3,)."""
+
+    grip: np.ndarray
+    rot: np.ndarray
+    elbow: np.ndarray
+
+
+@dataclass
+class _Keys:
+    """Two key tracks of one hand: where the hand is (``t``, ``grip``, ``rot``,
+    ``elbow``) and how high the stick is raised (``lift_t``, ``lift``); each
+    ``*profile`` is the shape of the segment ending at that key."""
+
+    t: np.ndarray  # (K,)
+    grip: np.ndarray  # (K, 3)
+    rot: np.ndarray  # (K, 4)
+    elbow: np.ndarray  # (K, 3)
+    profile: np.ndarray  # (K,)
+    lift_t: np.ndarray  # (L,)
+    lift: np.ndarray  # (L,)
+    lift_profile: np.ndarray  # (L,)
+
+
+def _shaped(keys_t: np.ndarray, profile: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(i0, i1, u): the segment of each time and the shaped fraction along it."""
+    n = keys_t.size
+    i1 = np.clip(np.searchsorted(keys_t, t, side="right"), 1, max(n - 1, 1))
+    i0 = i1 - 1
+    if n == 1:
+        return np.zeros_like(i0), np.zeros_like(i0), np.zeros(t.shape)
+    span = keys_t[i1] - keys_t[i0]
+    ok = span > 1e-12
+    u = np.where(ok, np.clip((t - keys_t[i0]) / np.where(ok, span, 1.0), 0.0, 1.0), 1.0)
+    u = np.where(t < keys_t[0], 0.0, u)
+    prof = profile[i1]
+    u = np.where(
+        prof == _ACCEL, u * u, np.where(prof == _DECEL, 1.0 - (1.0 - u) ** 2, u * u * (3 - 2 * u))
+    )
+    return i0, i1, u
+
+
+class DrummerHands:
+    """The strokes of the drummer's two hands and the arm poses made from them."""
+
+    def __init__(
+        self, root: np.ndarray, idle_local: np.ndarray, settings: HandSettings | None = None
+    ) -> None:
+        self.settings = settings or HandSettings.load()
+        self._root = np.asarray(root, dtype=np.float64)
+        self._idle = np.asarray(idle_local, dtype=np.float64)
+        p, r = _SK.fk(self._idle, self._root)
+        self._shoulder = {h: p[_SK.index(f"{_SIDE[h]}Arm")] for h in HANDS}
+        self._shoulder_rot = {h: r[_SK.index(f"{_SIDE[h]}Shoulder")] for h in HANDS}
+        self._joints = {
+            h: np.array(
+                [_SK.index(f"{_SIDE[h]}{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")]
+            )
+            for h in HANDS
+        }
+        self._l1 = {
+            h: float(np.linalg.norm(_SK.offsets[_SK.index(f"{_SIDE[h]}ForeArm")])) for h in HANDS
+        }
+        self._l2 = {
+            h: float(np.linalg.norm(_SK.offsets[_SK.index(f"{_SIDE[h]}Hand")])) for h in HANDS
+        }
+        self._grip_off = {h: _SK.offsets[_SK.index(f"{_SIDE[h]}HandEnd")] for h in HANDS}
+        self._times: dict[str, list[float]] = {h: [] for h in HANDS}
+        self._strokes: dict[str, list[tuple[_Pose, int]]] = {h: [] for h in HANDS}
+        self._rest: dict[str, _Pose | None] = dict.fromkeys(HANDS)
+        self._ref: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None] = (
+            dict.fromkeys(HANDS)
+        )
+        self._poses: dict[tuple[str, int], _Pose] = {}
+        self._keys: dict[str, _Keys | None] = dict.fromkeys(HANDS)
+
+    @property
+    def enabled(self) -> bool:
+        return self.settings.enabled
+
+    def has_strokes(self, hand: str) -> bool:
+        return bool(self._times.get(hand))
+
+    # ------------------------------------------------------------------ input
+
+    def _clip_pose(self, clip: Clip, frame: int) -> _Pose:
+        key = (clip.name, frame)
+        got = self._poses.get(key)
+        if got is not None:
+            return got
+        hand = clip.limb or ""
+        side = _SIDE[hand]
+        loc = self._idle.copy()
+        ji = [_SK.index(j) for j in clip.joints]
+        loc[ji] = clip.rotations[frame, ji]
+        p, r = _SK.fk(loc, self._root)
+        pose = _Pose(
+            p[_SK.index(f"{side}HandEnd")].copy(),
+            r[_SK.index(f"{side}Hand")].copy(),
+            p[_SK.index(f"{side}ForeArm")] - self._shoulder[hand],
+        )
+        self._poses[key] = pose
+        if self._ref[hand] is None:  # the arm's reference frames for the IK (the ready pose)
+            a, f, w = (_SK.index(f"{side}{j}") for j in ("Arm", "ForeArm", "Hand"))
+            self._ref[hand] = (p[f] - p[a], p[w] - p[f], r[a].copy(), r[f].copy())
+        return pose
+
+    def add_stroke(self, hand: str, impact: float, clip: Clip, velocity: int) -> None:
+        """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame."""
+        if hand not in self._times:
+            return
+        if self._rest[hand] is None:
+            self._rest[hand] = self._clip_pose(clip, 0)
+        pose = self._clip_pose(clip, int(round(clip.impact_s * clip.fps)))
+        i = bisect.bisect_right(self._times[hand], impact)
+        self._times[hand].insert(i, impact)
+        self._strokes[hand].insert(i, (pose, int(velocity)))
+        self._keys[hand] = None
+
+    def forget_before(self, time_s: float) -> None:
+        horizon = time_s - 10.0
+        for h in HANDS:
+            k = max(bisect.bisect_left(self._times[h], horizon) - 1, 0)
+            if k:
+                del self._times[h][:k]
+                del self._strokes[h][:k]
+                self._keys[h] = None
+
+    # ------------------------------------------------------------------ keys
+
+    def _lift_for(self, velocity: int, gap: float) -> float:
+        s = self.settings
+        by_vel = s.lift_soft_m + (s.lift_loud_m - s.lift_soft_m) * min(max(velocity, 0), 127) / 127
+        return float(min(by_vel, s.lift_per_s * gap))
+
+    def _build(self, hand: str) -> _Keys:
+        s = self.settings
+        rest = self._rest[hand]
+        assert rest is not None
+        poses: list[tuple[float, _Pose, int]] = []
+        lifts: list[tuple[float, float, int]] = []
+        prev_t: float | None = None
+        prev: _Pose = rest
+        for t, (pose, vel) in zip(self._times[hand], self._strokes[hand], strict=True):
+            gap = math.inf if prev_t is None else t - prev_t
+            lift = self._lift_for(vel, gap)
+            down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
+            travel = float(np.linalg.norm(pose.grip - prev.grip)) / s.move_speed_m_s
+            rise = min(2 * down + 0.05, 0.5 * gap)  # the backswing before the downstroke
+            if prev_t is None:
+                move = max(travel, s.rest_move_s)
+                poses.append((t - move, rest, _SMOOTH))
+                lifts.append((t - down - rise, 0.0, _SMOOTH))
+            else:
+                rebound = min(s.rebound_share * gap, s.rebound_max_s)
+                hover = min(s.hover_m, s.lift_per_s * gap)
+                back = float(np.linalg.norm(pose.grip - rest.grip)) / s.move_speed_m_s
+                away = prev_t + 0.5 * s.rest_after_s  # a hand left alone goes to rest
+                if t - max(back, s.rest_move_s) > away + s.rest_move_s + 0.1:
+                    poses.append((away, prev, _SMOOTH))
+                    poses.append((away + s.rest_move_s, rest, _SMOOTH))
+                    poses.append((t - max(back, s.rest_move_s), rest, _SMOOTH))
+                    lifts.append((prev_t + rebound, hover, _DECEL))
+                    lifts.append((away, hover, _SMOOTH))
+                    lifts.append((away + s.rest_move_s, 0.0, _SMOOTH))
+                    lifts.append((t - down - rise, 0.0, _SMOOTH))
+                else:
+                    # hover over the last piece; leave it only when the move must start
+                    leave = t - travel
+                    if leave > prev_t + 1e-3:
+                        poses.append((leave, prev, _SMOOTH))
+                    if t - down - rise > prev_t + rebound + 1e-3:
+                        lifts.append((prev_t + rebound, hover, _DECEL))
+                        lifts.append((t - down - rise, hover, _SMOOTH))
+            poses.append((t, pose, _SMOOTH))
+            lifts.append((t - down, lift, _SMOOTH))
+            lifts.append((t, 0.0, _ACCEL))
+            prev_t, prev = t, pose
+        if prev_t is not None:
+            away = prev_t + 0.5 * s.rest_after_s
+            poses.append((away, prev, _SMOOTH))
+            poses.append((away + s.rest_move_s, rest, _SMOOTH))
+            lifts.append((prev_t + s.rebound_max_s, s.hover_m, _DECEL))
+            lifts.append((away, s.hover_m, _SMOOTH))
+            lifts.append((away + s.rest_move_s, 0.0, _SMOOTH))
+        # keys never go back in time (a first stroke's approach may start early)
+        return _Keys(
+            np.maximum.accumulate(np.array([r[0] for r in poses])),
+            np.array([r[1].grip for r in poses]),
+            np.array([r[1].rot for r in poses]),
+            np.array([r[1].elbow for r in poses]),
+            np.array([r[2] for r in poses], dtype=np.int64),
+            np.maximum.accumulate(np.array([r[0] for r in lifts])),
+            np.array([r[1] for r in lifts]),
+            np.array([r[2] for r in lifts], dtype=np.int64),
+        )
+
+    def keys(self, hand: str) -> _Keys | None:
+        if not self._times[hand]:
+            return None
+        k = self._keys[hand]
+        if k is None:
+            k = self._keys[hand] = self._build(hand)
+        return k
+
+    # ------------------------------------------------------------------ output
+
+    def targets(self, hand: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Wrist position (m, 3), hand world rotation (m, 4) and elbow hint (m, 3) at ``times``."""
+        k = self.keys(hand)
+        assert k is not None
+        t = np.asarray(times, dtype=np.float64)
+        i0, i1, u = _shaped(k.t, k.profile, t)
+        grip = k.grip[i0] + u[:, None] * (k.grip[i1] - k.grip[i0])
+        elbow = k.elbow[i0] + u[:, None] * (k.elbow[i1] - k.elbow[i0])
+        rot = quat.slerp(k.rot[i0], k.rot[i1], u)
+        j0, j1, w = _shaped(k.lift_t, k.lift_profile, t)
+        lift = k.lift[j0] + w * (k.lift[j1] - k.lift[j0])
+        off = self._grip_off[hand]
+        wrist = grip - quat.rotate(rot, off)
+        # the stick turns up about the wrist, the wrist rises a share of the lift
+        s = self.settings
+        d = quat.rotate(rot, STICK_AXIS_LOCAL)
+        axis = np.cross(d, _UP)
+        norm = np.linalg.norm(axis, axis=-1, keepdims=True)
+        axis = axis / np.maximum(norm, 1e-9)
+        lever = STICK_TIP_M + float(np.linalg.norm(off))
+        sin_a = -d[:, 1]  # the stick's slope below the horizontal
+        rise = (1.0 - s.wrist_share) * lift
+        theta = np.arcsin(np.clip(rise / lever - sin_a, -1.0, math.sin(math.radians(60.0))))
+        theta = theta + np.arcsin(np.clip(sin_a, -1.0, 1.0))
+        rot = quat.multiply(quat.from_axis_angle(axis, theta), rot)
+        wrist = wrist + (s.wrist_share * lift)[:, None] * _UP
+        return wrist, rot, elbow
+
+    def local(self, hand: str, times: np.ndarray) -> np.ndarray:
+        """Local rotations (m, 4, 4) of the hand's Shoulder, Arm, ForeArm, Hand at ``times``."""
+        wrist, rot, elbow = self.targets(hand, times)
+        ref = self._ref[hand]
+        assert ref is not None
+        up_ref, lo_ref, r_arm, r_fore = ref
+        shoulder = self._shoulder[hand]
+        l1, l2 = self._l1[hand], self._l2[hand]
+        to = wrist - shoulder
+        dist = np.linalg.norm(to, axis=-1)
+        d = np.clip(dist, abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
+        u = to / np.maximum(dist, 1e-9)[:, None]
+        v = elbow - np.sum(elbow * u, axis=-1, keepdims=True) * u
+        v = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+        cos_a = np.clip((l1**2 + d**2 - l2**2) / (2 * l1 * d), -1.0, 1.0)
+        a = np.arccos(cos_a)[:, None]
+        up_new = l1 * (np.cos(a) * u + np.sin(a) * v)
+        lo_new = d[:, None] * u - up_new
+        m_up = _frames(up_new, lo_new) @ np.swapaxes(_frames(up_ref, lo_ref), -1, -2)
+        m_lo = _frames(lo_new, -up_new) @ np.swapaxes(_frames(lo_ref, -up_ref), -1, -2)
+        world_up = quat.multiply(quat.from_matrix(m_up), r_arm)
+        world_lo = quat.multiply(quat.from_matrix(m_lo), r_fore)
+        out = np.empty((len(wrist), 4, 4))
+        out[:, 0] = self._idle[self._joints[hand][0]]
+        out[:, 1] = quat.multiply(quat.conjugate(self._shoulder_rot[hand]), world_up)
+        out[:, 2] = quat.multiply(quat.conjugate(world_up), world_lo)
+        out[:, 3] = quat.multiply(quat.conjugate(world_lo), rot)
+        return out
+
+    def joint_index(self, hand: str) -> np.ndarray:
+        return self._joints[hand]
+
+
+def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frames (..., 3, 3), columns [d, h orthogonalised, d x h]."""
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
+    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
+    return np.stack([d, h, np.cross(d, h)], axis=-1)
+
+
+__all__ = ["DrummerHands", "HandSettings", "HANDS"]

@@ -14,10 +14,13 @@ from virja.bench import _demo_animator
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import disc_transforms, segment_transforms, sphere_transforms
+from virja.render.pedals import BEATER_BALL_M, beater, footboards
 from virja.render.renderer import DrawList
 from virja.render.scene import (
     BASSIST_SHIRT,
+    BEATER,
     BRASS,
+    CHROME,
     DRUMMER_SHIRT,
     HEAD,
     HEAD_HIT,
@@ -49,6 +52,11 @@ def plain_band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     s = np.asarray(pose.sticks, dtype=np.float64).reshape(-1, 2, 3)
     dl.add("cylinder", segment_transforms(s[:, 0], s[:, 1], 0.0075), STICK)
     dl.add("sphere", sphere_transforms(s[:, 1], 0.009), STICK)
+    boards, (kick_down, _hihat_down) = footboards(geo, pose)
+    axle, ball = beater(geo, kick_down)
+    dl.add("cylinder", segment_transforms([axle], [ball], 0.006), CHROME)
+    dl.add("sphere", sphere_transforms([ball], BEATER_BALL_M), BEATER)
+    dl.add("box", boards, CHROME)
     return dl
 
 

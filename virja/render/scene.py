@@ -27,6 +27,7 @@ from virja.render.meshes import (
     segment_transforms,
     sphere_transforms,
 )
+from virja.render.pedals import BEATER_BALL_M, beater, footboards
 from virja.render.renderer import DrawList
 from virja.vocab import BASS_STRINGS
 
@@ -46,6 +47,7 @@ EBONY = (0.04, 0.03, 0.03, 0.5)
 STRING = (0.75, 0.72, 0.62, 0.8)
 STRING_HOT = (1.0, 0.85, 0.35, 0.8)
 STICK = (0.85, 0.72, 0.48, 0.3)
+BEATER = (0.92, 0.90, 0.86, 0.2)  # a felt beater
 SKIN = (0.80, 0.58, 0.45, 0.15)
 DRUMMER_SHIRT = (0.16, 0.30, 0.62, 0.1)
 BASSIST_SHIRT = (0.55, 0.42, 0.12, 0.1)
@@ -115,14 +117,7 @@ def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
                     ),
                     CHROME,
                 )
-    for pedal in (kit.kick_pedal, kit.hihat_pedal):
-        dl.add(
-            "box",
-            box_transforms(
-                [pedal.heel + pedal.board * pedal.length / 2], [[0.09, 0.02, pedal.length]]
-            ),
-            CHROME,
-        )
+    # the footboards and the kick's beater move with the feet: band_scene (virja.render.pedals)
     _bass_static(dl, geo)
     return dl.freeze()
 
@@ -220,7 +215,16 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     else:
         parts.append(_figure_parts(pose.bass, BASSIST_SHIRT))
     parts.append(stick)
+    boards, (kick_down, _hh_down) = footboards(geo, pose)
+    axle, ball = beater(geo, kick_down)
+    parts.append(
+        _Parts(
+            segments=[(axle[None], ball[None], np.full(1, 0.006), _rows(CHROME, 1))],
+            spheres=[(ball[None], np.full(1, BEATER_BALL_M), _rows(BEATER, 1))],
+        )
+    )
     dl = DrawList()
+    dl.add("box", boards, CHROME)
     seg, seg_color = _segment_rows(parts)
     dl.add("cylinder", np.concatenate([kit_cyl, seg]), np.concatenate([kit_color, seg_color]))
     sph, sph_color = _sphere_rows(parts)

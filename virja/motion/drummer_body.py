@@ -66,6 +66,7 @@ class BodySettings:
     breath_period_s: float = 3.6
     beat_deg: float = 1.5
     sway_deg: float = 2.0
+    sway_floor: float = 0.8
     reference_spb: float = 0.5
     engage_s: float = 1.0
     release_s: float = 0.5
@@ -204,7 +205,7 @@ class DrummerBody:
         """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
         s = self.settings
         phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
-        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, 0.5, 1.5)
+        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, s.sway_floor, 1.5)
         return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
 
     # ------------------------------------------------------------------ apply

@@ -14,7 +14,9 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   time is short); after ``rest_after_s`` without a stroke it goes to the
   relaxed ready pose and comes back in time for the next.
 - **lift**: velocity sets the stick tip's height above the surface (not a
-  scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity and
+  scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity
+  (to the power ``lift_curve``; a side-stick at most ``side_stick_m``, a rim
+  shot at least ``rim_min_m``) and
   at most ``lift_per_s`` times the time since the previous stroke; the stick
   turns up about the wrist (the wrist itself rises ``wrist_share`` of it), so a
   soft stroke is a low one and nothing dives under a head or a cymbal.
@@ -59,7 +61,10 @@ class HandSettings:
     enabled: bool = True
     lift_soft_m: float = 0.03
     lift_loud_m: float = 0.30
+    lift_curve: float = 1.5
     lift_per_s: float = 1.6
+    side_stick_m: float = 0.03
+    rim_min_m: float = 0.2
     hover_m: float = 0.05
     wrist_share: float = 0.3
     down_share: float = 0.3
@@ -95,7 +100,10 @@ class HandSettings:
                 enabled=bool(d.get("enabled", True)),
                 lift_soft_m=float(lift["soft_m"]),
                 lift_loud_m=float(lift["loud_m"]),
+                lift_curve=float(lift["curve"]),
                 lift_per_s=float(lift["per_s"]),
+                side_stick_m=float(d["articulation"]["side_stick_m"]),
+                rim_min_m=float(d["articulation"]["rim_min_m"]),
                 hover_m=float(lift["hover_m"]),
                 wrist_share=float(lift["wrist_share"]),
                 down_share=float(time["down_share"]),
@@ -188,7 +196,7 @@ class DrummerHands:
         }
         self._grip_off = {h: _SK.offsets[_SK.index(f"{_SIDE[h]}HandEnd")] for h in HANDS}
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
-        self._strokes: dict[str, list[tuple[_Pose, int]]] = {h: [] for h in HANDS}
+        self._strokes: dict[str, list[tuple[_Pose, int, str | None]]] = {h: [] for h in HANDS}
         self._rest: dict[str, _Pose | None] = dict.fromkeys(HANDS)
         self._ref: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None] = (
             dict.fromkeys(HANDS)
@@ -227,8 +235,11 @@ class DrummerHands:
             self._ref[hand] = (p[f] - p[a], p[w] - p[f], r[a].copy(), r[f].copy())
         return pose
 
-    def add_stroke(self, hand: str, impact: float, clip: Clip, velocity: int) -> None:
-        """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame."""
+    def add_stroke(
+        self, hand: str, impact: float, clip: Clip, velocity: int, articulation: str | None = None
+    ) -> None:
+        """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame
+        (``articulation`` from the kit map: a side-stick lifts little, a rim shot fully)."""
         if hand not in self._times:
             return
         if self._rest[hand] is None:
@@ -236,7 +247,7 @@ class DrummerHands:
         pose = self._clip_pose(clip, int(round(clip.impact_s * clip.fps)))
         i = bisect.bisect_right(self._times[hand], impact)
         self._times[hand].insert(i, impact)
-        self._strokes[hand].insert(i, (pose, int(velocity)))
+        self._strokes[hand].insert(i, (pose, int(velocity), articulation))
         self._keys[hand] = None
 
     def forget_before(self, time_s: float) -> None:
@@ -250,9 +261,14 @@ class DrummerHands:
 
     # ------------------------------------------------------------------ keys
 
-    def _lift_for(self, velocity: int, gap: float) -> float:
+    def _lift_for(self, velocity: int, gap: float, articulation: str | None) -> float:
         s = self.settings
-        by_vel = s.lift_soft_m + (s.lift_loud_m - s.lift_soft_m) * min(max(velocity, 0), 127) / 127
+        v = (min(max(velocity, 0), 127) / 127) ** s.lift_curve
+        by_vel = s.lift_soft_m + (s.lift_loud_m - s.lift_soft_m) * v
+        if articulation == "side_stick":  # the butt clicks on the rim: a short tilt
+            by_vel = min(by_vel, s.side_stick_m)
+        elif articulation == "rim":  # a rim shot is an accent: a full stroke
+            by_vel = max(by_vel, s.rim_min_m)
         return float(min(by_vel, s.lift_per_s * gap))
 
     def _build(self, hand: str) -> _Keys:
@@ -263,9 +279,10 @@ class DrummerHands:
         lifts: list[tuple[float, float, int]] = []
         prev_t: float | None = None
         prev: _Pose = rest
-        for t, (pose, vel) in zip(self._times[hand], self._strokes[hand], strict=True):
+        prev_lift = 0.0
+        for t, (pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
             gap = math.inf if prev_t is None else t - prev_t
-            lift = self._lift_for(vel, gap)
+            lift = self._lift_for(vel, gap, art)
             down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
             travel = float(np.linalg.norm(pose.grip - prev.grip)) / s.move_speed_m_s
             rise = min(2 * down + 0.05, 0.5 * gap)  # the backswing before the downstroke
@@ -275,7 +292,7 @@ class DrummerHands:
                 lifts.append((t - down - rise, 0.0, _SMOOTH))
             else:
                 rebound = min(s.rebound_share * gap, s.rebound_max_s)
-                hover = min(s.hover_m, s.lift_per_s * gap)
+                hover = min(s.hover_m, s.lift_per_s * gap, prev_lift)
                 back = float(np.linalg.norm(pose.grip - rest.grip)) / s.move_speed_m_s
                 away = prev_t + 0.5 * s.rest_after_s  # a hand left alone goes to rest
                 if t - max(back, s.rest_move_s) > away + s.rest_move_s + 0.1:
@@ -297,13 +314,14 @@ class DrummerHands:
             poses.append((t, pose, _SMOOTH))
             lifts.append((t - down, lift, _SMOOTH))
             lifts.append((t, 0.0, _ACCEL))
-            prev_t, prev = t, pose
+            prev_t, prev, prev_lift = t, pose, lift
         if prev_t is not None:
+            hover = min(s.hover_m, prev_lift)
             away = prev_t + 0.5 * s.rest_after_s
             poses.append((away, prev, _SMOOTH))
             poses.append((away + s.rest_move_s, rest, _SMOOTH))
-            lifts.append((prev_t + s.rebound_max_s, s.hover_m, _DECEL))
-            lifts.append((away, s.hover_m, _SMOOTH))
+            lifts.append((prev_t + s.rebound_max_s, hover, _DECEL))
+            lifts.append((away, hover, _SMOOTH))
             lifts.append((away + s.rest_move_s, 0.0, _SMOOTH))
         # keys never go back in time (a first stroke's approach may start early)
         return _Keys(

@@ -130,6 +130,7 @@ class BeatTable(Schema):
     spine_deg: float
     sway_deg: float
     reference_spb: float
+    sway_floor: float | None = None  # absent: BodySettings' default
 
 
 class ArmsTable(Schema):
@@ -161,6 +162,7 @@ def body_settings(path: Path) -> BodySettings:
         breath_period_s=f.breath.period_s,
         beat_deg=f.beat.spine_deg,
         sway_deg=f.beat.sway_deg,
+        sway_floor=BodySettings.sway_floor if f.beat.sway_floor is None else f.beat.sway_floor,
         reference_spb=f.beat.reference_spb,
         engage_s=f.arms.engage_s,
         release_s=f.arms.release_s,

@@ -1,0 +1,158 @@
+"""The drummer's hands from where they are (virja.motion.drummer_hands)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.motion.helpers import drum
+from virja.errors import ConfigError
+from virja.geometry import GEOMETRY
+from virja.motion.band import BandAnimator, sticks
+from virja.motion.clip import MotionLibrary
+from virja.motion.drummer_body import BodySettings
+from virja.motion.drummer_hands import HandSettings
+from virja.motion.drummer_kit import default_articulations
+from virja.motion.metrics import contact_distance
+from virja.motion.skeleton import SKELETON
+
+HANDS_ON = HandSettings()
+PIECES = ("snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash")
+
+
+def _tips(a: BandAnimator, times: np.ndarray) -> np.ndarray:
+    """Stick tips (m, 2, 3) [left, right] at ``times``."""
+    pos, rot = SKELETON.fk(a.local_rotations_many(times), a._roots)
+    return sticks(pos[:, 0], rot[:, 0])[:, :, 1]
+
+
+def _wrists(a: BandAnimator, times: np.ndarray, side: str) -> np.ndarray:
+    pos, _rot = SKELETON.fk(a.local_rotations_many(times), a._roots)
+    return pos[:, 0, SKELETON.index(f"{side}Hand")]
+
+
+@pytest.mark.parametrize("hand", ["left_hand", "right_hand"])
+def test_every_piece_is_struck_exactly_from_the_previous_one(
+    library: MotionLibrary, hand: str
+) -> None:
+    """Strokes on every piece in turn, each from where the last one left the hand:
+    the tip is on the piece at each impact, single and batched sampling agree."""
+    a = BandAnimator(library, hands=HANDS_ON)
+    notes = [
+        drum(f"{piece}_{hand}", 1.0 + 0.6 * k - 0.3, 1.0 + 0.6 * k, velocity=40 + 12 * k)
+        for k, piece in enumerate(PIECES)
+    ]
+    for p in notes:
+        a.add_planned(p)
+    for p in notes:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4, p.motion
+    ts = np.array([p.impact for p in notes] + [p.impact + 0.2 for p in notes])
+    ts.sort()
+    many = a.local_rotations_many(ts)
+    one = np.stack([a.local_rotations(float(t)) for t in ts])
+    np.testing.assert_allclose(np.abs(np.sum(many * one, axis=-1)), 1.0, atol=1e-9)
+
+
+def test_a_hand_hovers_over_the_ride_between_ride_strokes(library: MotionLibrary) -> None:
+    """Between two ride strokes half a second apart the tip stays over the ride (the
+    clips went 30-50 cm back toward the snare), and above its surface."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    for t in (1.0, 1.5, 2.0):
+        a.add_planned(drum("ride_right_hand", t - 0.25, t, velocity=80))
+    ts = np.linspace(1.0, 2.0, 121)
+    tip = _tips(a, ts)[:, 1]
+    ride = GEOMETRY.kit.pieces["ride"]
+    rel = tip - ride.centre
+    h = rel @ ride.normal
+    radial = np.linalg.norm(rel - h[:, None] * ride.normal, axis=1)
+    assert radial.max() < ride.radius  # never leaves the ride
+    assert h.min() > -0.003  # never under its top
+    clips = BandAnimator(library, body=BodySettings.still(), hands=HandSettings.clips())
+    for t in (1.0, 1.5, 2.0):
+        clips.add_planned(drum("ride_right_hand", t - 0.25, t, velocity=80))
+    away = np.linalg.norm(_tips(clips, ts)[:, 1] - ride.centre, axis=1).max()
+    assert away > ride.radius  # the clips did go back to the snare
+
+
+def test_velocity_sets_the_backswing_height_and_time_limits_it(library: MotionLibrary) -> None:
+    """A loud stroke lifts the tip higher than a soft one; a short gap lifts it less."""
+
+    def peak(velocity: int, gap: float) -> float:
+        a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+        a.add_planned(drum("snare_left_hand", 0.5, 1.0, velocity=velocity))
+        a.add_planned(drum("snare_left_hand", 1.0 + gap - 0.1, 1.0 + gap, velocity=velocity))
+        ts = np.linspace(1.0, 1.0 + gap, 61)
+        return float(_tips(a, ts)[:, 0, 1].max() - _tips(a, np.array([1.0]))[0, 0, 1])
+
+    soft, loud = peak(30, 0.6), peak(120, 0.6)
+    assert loud > soft + 0.1
+    assert soft < 0.07
+    assert peak(120, 0.08) < 0.14  # 1.6 m/s x 0.08 s: the hand cannot lift 30 cm in time
+
+
+def test_a_soft_stroke_on_a_cymbal_never_goes_under_it(library: MotionLibrary) -> None:
+    """Velocity acts on the tip's height: after a soft crash the tip rises, no dive."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    a.add_planned(drum("crash_left_hand", 0.6, 1.0, velocity=30))
+    ts = np.linspace(0.9, 1.6, 85)
+    crash = GEOMETRY.kit.pieces["crash"]
+    h = (_tips(a, ts)[:, 0] - crash.centre) @ crash.normal
+    assert h.min() > -0.003
+
+
+def test_moves_are_timed_by_distance_with_bounded_speed(library: MotionLibrary) -> None:
+    """Snare then floor tom a second later: the hand waits over the snare and leaves in
+    time; its wrist never goes faster than the move speed allows (smoothstep: 1.5x)."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    a.add_planned(drum("snare_right_hand", 0.6, 1.0, velocity=60))
+    a.add_planned(drum("tom_floor_right_hand", 1.8, 2.0, velocity=60))
+    ts = np.linspace(1.0, 2.0, 241)
+    w = _wrists(a, ts, "Right")
+    speed = np.linalg.norm(np.diff(w, axis=0), axis=1) / np.diff(ts)
+    assert speed.max() < 1.5 * HANDS_ON.move_speed_m_s + 1.5  # + the stick's lift
+    still = np.linalg.norm(w[ts < 1.5] - w[ts < 1.5][-1], axis=1).max()
+    assert still < 0.05  # hovering over the snare, not already on the way
+
+
+def test_a_hand_left_alone_goes_to_rest_and_comes_back(library: MotionLibrary) -> None:
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    a.add_planned(drum("ride_right_hand", 0.6, 1.0))
+    a.add_planned(drum("ride_right_hand", 5.6, 6.0))
+    rest = _wrists(a, np.array([0.0]), "Right")[0]
+    mid = _wrists(a, np.array([3.5]), "Right")[0]
+    at_ride = _wrists(a, np.array([1.2]), "Right")[0]
+    assert np.linalg.norm(mid - rest) < 0.01
+    assert np.linalg.norm(at_ride - rest) > 0.2
+    p = drum("ride_right_hand", 5.6, 6.0)
+    assert contact_distance(a, p, 6.0)[0] < 1e-4
+
+
+def test_settings_load_and_errors(tmp_path: Path) -> None:
+    assert HandSettings.load().enabled
+    assert not HandSettings.clips().enabled
+    bad = tmp_path / "hands.toml"
+    bad.write_text("[lift]\nsoft_m = 0.03\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match="hands.toml: missing key"):
+        HandSettings.load(bad)
+    text = (Path(__file__).parents[2] / "motions" / "drummer_hands.toml").read_text()
+    bad.write_text(text.replace("speed_m_s = 2.5", "speed_m_s = 0"), encoding="utf-8")
+    with pytest.raises(ConfigError, match="move_speed_m_s must be a finite number > 0"):
+        HandSettings.load(bad)
+
+
+def test_a_side_stick_only_tilts_and_a_rim_shot_is_a_full_stroke(library: MotionLibrary) -> None:
+    """The kit map's articulation: side-stick (37) lifts at most 3 cm, a rim shot fully."""
+
+    def peak(note: int, velocity: int) -> float:
+        a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+        for t in (1.0, 1.8):
+            a.add_planned(replace(drum("snare_left_hand", t - 0.3, t, velocity), note=note))
+        ts = np.linspace(1.0, 1.8, 97)
+        return float(_tips(a, ts)[:, 0, 1].max() - _tips(a, np.array([1.0]))[0, 0, 1])
+
+    assert peak(37, 100) < 0.035 < peak(38, 100)
+    rim = next(n for n, art in default_articulations().items() if art == "rim")
+    assert peak(rim, 40) > 0.15 > peak(38, 40)

@@ -156,3 +156,28 @@ def test_a_side_stick_only_tilts_and_a_rim_shot_is_a_full_stroke(library: Motion
     assert peak(37, 100) < 0.035 < peak(38, 100)
     rim = next(n for n, art in default_articulations().items() if art == "rim")
     assert peak(rim, 40) > 0.15 > peak(38, 40)
+
+
+def test_notes_arriving_at_their_start_change_nothing_already_drawn(library: MotionLibrary) -> None:
+    """A live session learns of a note at its start: the hand turns toward it from
+    where it is then, so frames drawn before never jump when the note arrives."""
+    notes = []
+    for k in range(12):  # ride and snare, alternating hands, short leads
+        t = 1.0 + 0.2 * k
+        notes.append(drum("ride_right_hand", t - 0.08, t, velocity=70 + 3 * k))
+        if k % 3 == 2:
+            notes.append(drum("snare_left_hand", t + 0.1 - 0.07, t + 0.1, velocity=50))
+    notes.sort(key=lambda p: p.start)
+    live = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    ts = np.arange(0.5, 4.0, 1 / 120)
+    wrists, k = [], 0
+    for t in ts:
+        while k < len(notes) and notes[k].start <= t:
+            live.add_planned(notes[k])
+            k += 1
+        pos, _rot = SKELETON.fk(live.local_rotations(float(t)), live._roots)
+        wrists.append(pos[0, [SKELETON.index("LeftHand"), SKELETON.index("RightHand")]])
+    step = np.linalg.norm(np.diff(np.array(wrists), axis=0), axis=-1).max()
+    assert step < 0.05  # 6 m/s at 120 fps: no jump
+    for p in notes:
+        assert contact_distance(live, p, p.impact)[0] < 1e-4

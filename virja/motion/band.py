@@ -235,7 +235,7 @@ class BandAnimator:
             )
             self._hits.add(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
             art = self.articulations.get(p.note)
-            self.hands.add_stroke(limb, p.impact, clip, p.velocity, art)
+            self.hands.add_stroke(limb, p.start, p.impact, clip, p.velocity, art)
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))

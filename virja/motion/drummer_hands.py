@@ -170,6 +170,52 @@ def _shaped(keys_t: np.ndarray, profile: np.ndarray, t: np.ndarray) -> tuple[np.
     return i0, i1, u
 
 
+def _shape(u: float, profile: int) -> float:
+    if profile == _ACCEL:
+        return u * u
+    if profile == _DECEL:
+        return 1.0 - (1.0 - u) ** 2
+    return u * u * (3 - 2 * u)
+
+
+def _pose_at(a: np.ndarray, b: np.ndarray, u: float) -> np.ndarray:
+    """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u``."""
+    out = a + u * (b - a)
+    out[3:7] = quat.slerp(a[3:7], b[3:7], u)
+    return out
+
+
+def _lift_at(a: float, b: float, u: float) -> float:
+    return a + u * (b - a)
+
+
+def _add(
+    times: list[float], values: list[Any], profiles: list[int], t: float, v: Any, p: int
+) -> None:
+    times.append(t)
+    values.append(v)
+    profiles.append(p)
+
+
+def _cut(times: list[float], values: list[Any], profiles: list[int], cut: float, at: Any) -> Any:
+    """The track's value at ``cut``; keys after ``cut`` are dropped and, unless one lies
+    exactly there, a key holding that value is put at ``cut`` (same segment shape)."""
+    k = bisect.bisect_right(times, cut)
+    if k == 0:
+        value = values[0]
+    elif k == len(times):
+        value = values[-1]
+    else:
+        span = times[k] - times[k - 1]
+        u = 1.0 if span <= 1e-12 else _shape((cut - times[k - 1]) / span, profiles[k])
+        value = at(values[k - 1], values[k], u)
+    prof = profiles[k] if k < len(times) else _SMOOTH
+    del times[k:], values[k:], profiles[k:]
+    if not times or times[-1] < cut:
+        _add(times, values, profiles, cut, value, prof)
+    return value
+
+
 class DrummerHands:
     """The strokes of the drummer's two hands and the arm poses made from them."""
 
@@ -196,7 +242,10 @@ class DrummerHands:
         }
         self._grip_off = {h: _SK.offsets[_SK.index(f"{_SIDE[h]}HandEnd")] for h in HANDS}
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
-        self._strokes: dict[str, list[tuple[_Pose, int, str | None]]] = {h: [] for h in HANDS}
+        # per stroke: (start, impact pose, velocity, articulation)
+        self._strokes: dict[str, list[tuple[float, _Pose, int, str | None]]] = {
+            h: [] for h in HANDS
+        }
         self._rest: dict[str, _Pose | None] = dict.fromkeys(HANDS)
         self._ref: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None] = (
             dict.fromkeys(HANDS)
@@ -236,10 +285,20 @@ class DrummerHands:
         return pose
 
     def add_stroke(
-        self, hand: str, impact: float, clip: Clip, velocity: int, articulation: str | None = None
+        self,
+        hand: str,
+        start: float,
+        impact: float,
+        clip: Clip,
+        velocity: int,
+        articulation: str | None = None,
     ) -> None:
-        """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame
-        (``articulation`` from the kit map: a side-stick lifts little, a rim shot fully)."""
+        """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame.
+
+        The hand changes course for it no earlier than ``start`` (when a live session
+        learns of the note), so what was drawn before stays true.  ``articulation``
+        from the kit map: a side-stick lifts little, a rim shot fully.
+        """
         if hand not in self._times:
             return
         if self._rest[hand] is None:
@@ -247,7 +306,7 @@ class DrummerHands:
         pose = self._clip_pose(clip, int(round(clip.impact_s * clip.fps)))
         i = bisect.bisect_right(self._times[hand], impact)
         self._times[hand].insert(i, impact)
-        self._strokes[hand].insert(i, (pose, int(velocity), articulation))
+        self._strokes[hand].insert(i, (min(start, impact), pose, int(velocity), articulation))
         self._keys[hand] = None
 
     def forget_before(self, time_s: float) -> None:
@@ -272,67 +331,68 @@ class DrummerHands:
         return float(min(by_vel, s.lift_per_s * gap))
 
     def _build(self, hand: str) -> _Keys:
+        """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
+        if nothing follows), cut where the next stroke becomes known (its start, never
+        before the last impact) and continued from the state there to the next impact."""
         s = self.settings
         rest = self._rest[hand]
         assert rest is not None
-        poses: list[tuple[float, _Pose, int]] = []
-        lifts: list[tuple[float, float, int]] = []
+        pt: list[float] = []  # pose keys: times, (grip, rot, elbow) rows, profiles
+        pv: list[np.ndarray] = []
+        pp: list[int] = []
+        lt: list[float] = []  # lift keys
+        lv: list[float] = []
+        lp: list[int] = []
         prev_t: float | None = None
-        prev: _Pose = rest
         prev_lift = 0.0
-        for t, (pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
-            gap = math.inf if prev_t is None else t - prev_t
-            lift = self._lift_for(vel, gap, art)
-            down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
-            travel = float(np.linalg.norm(pose.grip - prev.grip)) / s.move_speed_m_s
-            rise = min(2 * down + 0.05, 0.5 * gap)  # the backswing before the downstroke
+        for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
+            target = np.concatenate([pose.grip, pose.rot, pose.elbow])
             if prev_t is None:
-                move = max(travel, s.rest_move_s)
-                poses.append((t - move, rest, _SMOOTH))
-                lifts.append((t - down - rise, 0.0, _SMOOTH))
+                cut, gap = start, math.inf
+                here = np.concatenate([rest.grip, rest.rot, rest.elbow])
+                pt, pv, pp = [cut], [here], [_SMOOTH]
+                lt, lv, lp = [cut], [0.0], [_SMOOTH]
+                lift_here = 0.0
             else:
-                rebound = min(s.rebound_share * gap, s.rebound_max_s)
-                hover = min(s.hover_m, s.lift_per_s * gap, prev_lift)
-                back = float(np.linalg.norm(pose.grip - rest.grip)) / s.move_speed_m_s
-                away = prev_t + 0.5 * s.rest_after_s  # a hand left alone goes to rest
-                if t - max(back, s.rest_move_s) > away + s.rest_move_s + 0.1:
-                    poses.append((away, prev, _SMOOTH))
-                    poses.append((away + s.rest_move_s, rest, _SMOOTH))
-                    poses.append((t - max(back, s.rest_move_s), rest, _SMOOTH))
-                    lifts.append((prev_t + rebound, hover, _DECEL))
-                    lifts.append((away, hover, _SMOOTH))
-                    lifts.append((away + s.rest_move_s, 0.0, _SMOOTH))
-                    lifts.append((t - down - rise, 0.0, _SMOOTH))
-                else:
-                    # hover over the last piece; leave it only when the move must start
-                    leave = t - travel
-                    if leave > prev_t + 1e-3:
-                        poses.append((leave, prev, _SMOOTH))
-                    if t - down - rise > prev_t + rebound + 1e-3:
-                        lifts.append((prev_t + rebound, hover, _DECEL))
-                        lifts.append((t - down - rise, hover, _SMOOTH))
-            poses.append((t, pose, _SMOOTH))
-            lifts.append((t - down, lift, _SMOOTH))
-            lifts.append((t, 0.0, _ACCEL))
-            prev_t, prev, prev_lift = t, pose, lift
-        if prev_t is not None:
-            hover = min(s.hover_m, prev_lift)
-            away = prev_t + 0.5 * s.rest_after_s
-            poses.append((away, prev, _SMOOTH))
-            poses.append((away + s.rest_move_s, rest, _SMOOTH))
-            lifts.append((prev_t + s.rebound_max_s, hover, _DECEL))
-            lifts.append((away, hover, _SMOOTH))
-            lifts.append((away + s.rest_move_s, 0.0, _SMOOTH))
-        # keys never go back in time (a first stroke's approach may start early)
+                cut, gap = max(start, prev_t), t - prev_t
+                here = _cut(pt, pv, pp, cut, _pose_at)
+                lift_here = float(_cut(lt, lv, lp, cut, _lift_at))
+            lift = self._lift_for(vel, gap, art)
+            room = t - cut
+            down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
+            down = min(down, 0.5 * room) if room > 0 else 0.0
+            rise = min(2 * down + 0.05, 0.5 * gap)
+            travel = float(np.linalg.norm(target[:3] - here[:3])) / s.move_speed_m_s
+            if prev_t is None:
+                travel = max(travel, s.rest_move_s)
+            leave = t - travel  # hover where the hand is; leave only when the move must start
+            if leave > cut + 1e-4:
+                _add(pt, pv, pp, leave, here, _SMOOTH)
+            _add(pt, pv, pp, t, target, _SMOOTH)
+            if t - down - rise > cut + 1e-4:
+                _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)
+            _add(lt, lv, lp, t - down, lift, _SMOOTH)
+            _add(lt, lv, lp, t, 0.0, _ACCEL)
+            # the tail, as if no stroke followed: rebound to a hover, rest after a while
+            hover = min(s.hover_m, lift, prev_lift if prev_t is not None else lift)
+            away = t + 0.5 * s.rest_after_s
+            _add(lt, lv, lp, t + s.rebound_max_s, hover, _DECEL)
+            _add(lt, lv, lp, away, hover, _SMOOTH)
+            _add(lt, lv, lp, away + s.rest_move_s, 0.0, _SMOOTH)
+            _add(pt, pv, pp, away, target, _SMOOTH)
+            home = np.concatenate([rest.grip, rest.rot, rest.elbow])
+            _add(pt, pv, pp, away + s.rest_move_s, home, _SMOOTH)
+            prev_t, prev_lift = t, lift
+        rows = np.array(pv)
         return _Keys(
-            np.maximum.accumulate(np.array([r[0] for r in poses])),
-            np.array([r[1].grip for r in poses]),
-            np.array([r[1].rot for r in poses]),
-            np.array([r[1].elbow for r in poses]),
-            np.array([r[2] for r in poses], dtype=np.int64),
-            np.maximum.accumulate(np.array([r[0] for r in lifts])),
-            np.array([r[1] for r in lifts]),
-            np.array([r[2] for r in lifts], dtype=np.int64),
+            np.array(pt),
+            rows[:, :3],
+            rows[:, 3:7],
+            rows[:, 7:],
+            np.array(pp, dtype=np.int64),
+            np.array(lt),
+            np.array(lv),
+            np.array(lp, dtype=np.int64),
         )
 
     def keys(self, hand: str) -> _Keys | None:

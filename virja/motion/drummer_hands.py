@@ -35,14 +35,12 @@ from __future__ import annotations
 
 import bisect
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from virja.errors import ConfigError
 from virja.motion import quat
 from virja.motion.clip import Clip
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
@@ -89,41 +87,9 @@ class HandSettings:
             path = motions_dir() / "drummer_hands.toml"
         if not path.is_file():
             return cls()
-        where = str(path)
-        try:
-            d: dict[str, Any] = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (UnicodeDecodeError, tomllib.TOMLDecodeError, OSError) as exc:
-            raise ConfigError(f"{where}: cannot read: {exc}") from None
-        try:
-            lift, time, move = d["lift"], d["time"], d["move"]
-            s = cls(
-                enabled=bool(d.get("enabled", True)),
-                lift_soft_m=float(lift["soft_m"]),
-                lift_loud_m=float(lift["loud_m"]),
-                lift_curve=float(lift["curve"]),
-                lift_per_s=float(lift["per_s"]),
-                side_stick_m=float(d["articulation"]["side_stick_m"]),
-                rim_min_m=float(d["articulation"]["rim_min_m"]),
-                hover_m=float(lift["hover_m"]),
-                wrist_share=float(lift["wrist_share"]),
-                down_share=float(time["down_share"]),
-                down_min_s=float(time["down_min_s"]),
-                down_max_s=float(time["down_max_s"]),
-                rebound_share=float(time["rebound_share"]),
-                rebound_max_s=float(time["rebound_max_s"]),
-                move_speed_m_s=float(move["speed_m_s"]),
-                rest_after_s=float(move["rest_after_s"]),
-                rest_move_s=float(move["rest_move_s"]),
-            )
-        except KeyError as exc:
-            raise ConfigError(f"{where}: missing key {exc.args[0]!r}") from None
-        except (TypeError, ValueError) as exc:
-            raise ConfigError(f"{where}: a value has the wrong type: {exc}") from None
-        for name in ("lift_per_s", "move_speed_m_s", "rest_after_s", "rest_move_s", "down_max_s"):
-            v = getattr(s, name)
-            if not (math.isfinite(v) and v > 0):
-                raise ConfigError(f"{where}: {name} must be a finite number > 0, got {v}")
-        return s
+        from virja.motion.settings_files import hand_settings
+
+        return hand_settings(path)
 
 
 @dataclass(frozen=True)

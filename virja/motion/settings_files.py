@@ -1,6 +1,7 @@
 """The animators' constant files, each as one schema (virja.tomlconf):
-motions/animation.toml -> :class:`~virja.motion.band.AnimationSettings` and
-motions/drummer_body.toml -> :class:`~virja.motion.drummer_body.BodySettings`.
+motions/animation.toml -> :class:`~virja.motion.band.AnimationSettings`,
+motions/drummer_body.toml -> :class:`~virja.motion.drummer_body.BodySettings` and
+motions/drummer_hands.toml -> :class:`~virja.motion.drummer_hands.HandSettings`.
 
 A wrong type, a missing or an unknown key is a ConfigError naming the file and the
 key path; the reasons for each number are in the files' comments.
@@ -22,6 +23,7 @@ from virja.tomlconf import Schema
 if TYPE_CHECKING:
     from virja.motion.band import AnimationSettings
     from virja.motion.drummer_body import BodySettings
+    from virja.motion.drummer_hands import HandSettings
 
 Swing = tuple[float, float, float]  # angle (rad), per velocity gain, decay (s)
 
@@ -167,3 +169,79 @@ def body_settings(path: Path) -> BodySettings:
         engage_s=f.arms.engage_s,
         release_s=f.arms.release_s,
     )
+
+
+class HandLiftTable(Schema):
+    soft_m: float
+    loud_m: float
+    curve: float
+    per_s: float
+    hover_m: float
+    wrist_share: float
+
+
+class HandTimeTable(Schema):
+    down_share: float
+    down_min_s: float
+    down_max_s: float
+    rebound_share: float
+    rebound_max_s: float
+
+
+class HandMoveTable(Schema):
+    speed_m_s: float
+    rest_after_s: float
+    rest_move_s: float
+
+
+class HandArticulationTable(Schema):
+    side_stick_m: float
+    rim_min_m: float
+
+
+class DrummerHandsFile(Schema):
+    """motions/drummer_hands.toml"""
+
+    lift: HandLiftTable
+    time: HandTimeTable
+    move: HandMoveTable
+    articulation: HandArticulationTable
+    enabled: bool = True
+
+
+def hand_settings(path: Path) -> HandSettings:
+    """The settings of a drummer_hands.toml at ``path`` (speeds and times finite and > 0)."""
+    from virja.motion.drummer_hands import HandSettings
+
+    f = tomlconf.load(path, DrummerHandsFile)
+    settings = HandSettings(
+        enabled=f.enabled,
+        lift_soft_m=f.lift.soft_m,
+        lift_loud_m=f.lift.loud_m,
+        lift_curve=f.lift.curve,
+        lift_per_s=f.lift.per_s,
+        hover_m=f.lift.hover_m,
+        wrist_share=f.lift.wrist_share,
+        side_stick_m=f.articulation.side_stick_m,
+        rim_min_m=f.articulation.rim_min_m,
+        down_share=f.time.down_share,
+        down_min_s=f.time.down_min_s,
+        down_max_s=f.time.down_max_s,
+        rebound_share=f.time.rebound_share,
+        rebound_max_s=f.time.rebound_max_s,
+        move_speed_m_s=f.move.speed_m_s,
+        rest_after_s=f.move.rest_after_s,
+        rest_move_s=f.move.rest_move_s,
+    )
+    positive = {
+        "lift.per_s": settings.lift_per_s,
+        "lift.curve": settings.lift_curve,
+        "time.down_max_s": settings.down_max_s,
+        "move.speed_m_s": settings.move_speed_m_s,
+        "move.rest_after_s": settings.rest_after_s,
+        "move.rest_move_s": settings.rest_move_s,
+    }
+    for name, value in positive.items():
+        if not value > 0:
+            raise ConfigError(f"{path}: {name} must be a number > 0, got {value}")
+    return settings

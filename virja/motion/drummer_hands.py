@@ -335,9 +335,13 @@ class DrummerHands:
             if leave > cut + 1e-4:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
             _add(pt, pv, pp, t, target, _SMOOTH)
-            if t - down - rise > cut + 1e-4:
-                _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)
-            _add(lt, lv, lp, t - down, lift, _SMOOTH)
+            if prev_t is not None and cut <= prev_t:
+                # known at the last impact: the stick rebounds straight into the backswing
+                _add(lt, lv, lp, t - down, lift, _DECEL)
+            else:
+                if t - down - rise > cut + 1e-4:
+                    _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)
+                _add(lt, lv, lp, t - down, lift, _SMOOTH)
             _add(lt, lv, lp, t, 0.0, _ACCEL)
             # the tail, as if no stroke followed: rebound to a hover, rest after a while
             hover = min(s.hover_m, lift, prev_lift if prev_t is not None else lift)

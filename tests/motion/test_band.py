@@ -271,7 +271,9 @@ def test_unknown_motion_raises(library: MotionLibrary) -> None:
     with pytest.raises(UnknownMotionError, match="cowbell"):
         BandAnimator(library, body=STILL, hands=CLIPS).add_planned(cowbell)
     with pytest.raises(UnknownMotionError, match="pluck_A_fret3"):
-        BandAnimator(library, body=STILL, hands=CLIPS).add_planned(replace(note, motion=BassPluck("A", 3)))
+        BandAnimator(library, body=STILL, hands=CLIPS).add_planned(
+            replace(note, motion=BassPluck("A", 3))
+        )
 
 
 def test_default_library_is_shared() -> None:

@@ -67,10 +67,7 @@ class Performance:
         # packet; None until :meth:`mark_origin` (serve: the first datagram received)
         self._origin_s: float | None = None
         self.origin_s = origin_s
-        self.animator = animator
-        setter = getattr(animator, "set_articulations", None)
-        if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
-            setter({n: d.articulation for n, d in planner.config.kit.notes.items()})
+        self.animator = animator  # told the kit map and the tuning (the property below)
         self.plan_log = plan_log
         self.counts: Counter[str] = Counter()
         self.planned: list[PlannedNote] = []
@@ -79,9 +76,22 @@ class Performance:
         self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
         self.planned_taps: list[Callable[[PlannedNote], None]] = []  # and every note committed
         self.plan_log_failed: str | None = None
+
+    @property
+    def animator(self) -> PlanSink | None:
+        return self._animator
+
+    @animator.setter
+    def animator(self, animator: PlanSink | None) -> None:
+        """Set at construction or later (serve and replay build their sinks after): the
+        sink learns the kit map's articulations and the tuning's strings either way."""
+        self._animator = animator
+        setter = getattr(animator, "set_articulations", None)
+        if setter is not None:  # the hi-hat opens and closes as the (user's) kit map says
+            setter({n: d.articulation for n, d in self.planner.config.kit.notes.items()})
         strings = getattr(animator, "use_bass_strings", None)
         if strings is not None:  # the bassist plays (and shows) the strings of the tuning
-            strings(tuple(name for name, _ in planner.config.bass.strings))
+            strings(tuple(name for name, _ in self.planner.config.bass.strings))
 
     @property
     def origin_s(self) -> float | None:

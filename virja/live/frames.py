@@ -40,6 +40,10 @@ class Animator(Protocol):
 
     def forget_before(self, time_s: float) -> None: ...
 
+    def use_bass_strings(self, strings: tuple[str, ...]) -> None: ...
+
+    def set_articulations(self, articulations: dict[int, str | None]) -> None: ...
+
 
 @dataclass
 class Inbox:
@@ -96,6 +100,10 @@ class FrameLoop:
                 off = getattr(self.animator, "note_off", None)
                 if off is not None:
                     off(item[1], item[2])
+            elif kind == "strings":  # the tuning's strings: played and drawn (5/6-string)
+                self.animator.use_bass_strings(tuple(item[1]))
+            elif kind == "articulations":  # the kit map's hi-hat articulations
+                self.animator.set_articulations(dict(item[1]))
             elif kind == "clock":
                 self.anchor_s = float(item[1])
             elif kind == "stop":

@@ -8,7 +8,8 @@ slow belongs behind a queue of its own.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 from virja.events import Beat, Chord, NoteOff
 from virja.motion.pose import BandPose
@@ -21,10 +22,31 @@ class Fanout:
     """A :class:`~virja.session.PlanSink` that forwards to several."""
 
     def __init__(self, sinks: Iterable[PlanSink] = ()) -> None:
-        self.sinks: list[PlanSink] = list(sinks)
+        self.sinks: list[PlanSink] = []
+        self._strings: tuple[str, ...] | None = None
+        self._articulations: dict[int, str | None] | None = None
+        for s in sinks:
+            self.add(s)
 
     def add(self, sink: PlanSink) -> None:
+        """A sink more; it learns the tuning and kit map already told (a sink added late)."""
         self.sinks.append(sink)
+        if self._strings is not None:
+            _tell(sink, "use_bass_strings", self._strings)
+        if self._articulations is not None:
+            _tell(sink, "set_articulations", self._articulations)
+
+    def use_bass_strings(self, strings: tuple[str, ...]) -> None:
+        """The tuning's strings, to every sink that plays them (and to sinks added later)."""
+        self._strings = tuple(strings)
+        for s in self.sinks:
+            _tell(s, "use_bass_strings", self._strings)
+
+    def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
+        """The kit map's articulations, to every sink that takes them (and later ones)."""
+        self._articulations = dict(articulations)
+        for s in self.sinks:
+            _tell(s, "set_articulations", self._articulations)
 
     def add_planned(self, p: PlannedNote) -> None:
         for s in self.sinks:
@@ -62,3 +84,9 @@ class Fanout:
             off = getattr(s, "note_off", None)
             if off is not None:
                 off(performer, event)
+
+
+def _tell(sink: PlanSink, method: str, value: Any) -> None:
+    call = getattr(sink, method, None)
+    if call is not None:
+        call(value)

@@ -21,7 +21,7 @@ import queue
 import signal
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -118,6 +118,15 @@ class Viewer:
 
     def note_off(self, performer: Performer, event: NoteOff) -> None:
         self._put(("off", performer, event))
+
+    def use_bass_strings(self, strings: tuple[str, ...]) -> None:
+        """The tuning's strings (B E A D G for a five-string): the window's animator plays
+        and draws them (``Performance`` tells every sink that takes them)."""
+        self._put(("strings", tuple(strings)))
+
+    def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
+        """The kit map's hi-hat articulations, for the window's animator."""
+        self._put(("articulations", dict(articulations)))
 
     def _put(self, item: tuple[Any, ...]) -> None:
         if not self._shut:  # after close (a replay's last notes) nothing is drawn

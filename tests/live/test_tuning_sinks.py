@@ -11,7 +11,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tests.motion.helpers import bass
 from virja.events import NoteOn
 from virja.live.frames import FrameLoop, Inbox
 from virja.live.pacing import FramePacer

@@ -15,6 +15,8 @@ import pytest
 from tests.export.conftest import GMD_TAKES, VALIDATOR, gmd_take
 from virja import quat
 from virja.export import Export, export_performance
+from virja.geometry import GEOMETRY
+from virja.motion import bass_lean
 from virja.motion.band import BandAnimator
 from virja.motion.skeleton import SKELETON
 
@@ -46,8 +48,15 @@ def test_demo_glb_passes_the_khronos_validator(demo_export: Export) -> None:
     assert report["info"]["hasMorphTargets"]  # the strings
 
 
-def _world(doc: pygltflib.GLTF2, node_i: int, parents: dict[int, int], rot: dict[int, Any]) -> Any:
-    """World matrix of a node with some rotations replaced (an independent TRS composition)."""
+def _world(
+    doc: pygltflib.GLTF2,
+    node_i: int,
+    parents: dict[int, int],
+    rot: dict[int, Any],
+    trans: dict[int, Any] | None = None,
+) -> Any:
+    """World matrix of a node with some rotations (and translations) replaced (an
+    independent TRS composition)."""
     m = np.eye(4)
     chain = [node_i]
     while chain[-1] in parents:
@@ -56,7 +65,7 @@ def _world(doc: pygltflib.GLTF2, node_i: int, parents: dict[int, int], rot: dict
         n = doc.nodes[i]
         r = rot.get(i, n.rotation or [0, 0, 0, 1])
         t = np.eye(4)
-        t[:3, 3] = n.translation or [0, 0, 0]
+        t[:3, 3] = (trans or {}).get(i, n.translation or [0, 0, 0])
         rm = np.eye(4)
         rm[:3, :3] = quat.to_matrix(np.array([r[3], r[0], r[1], r[2]]))
         s = np.diag([*(n.scale or [1, 1, 1]), 1.0])
@@ -105,6 +114,19 @@ def test_glb_node_hierarchy_reproduces_the_band_pose(demo_export: Export, tmp_pa
             assert np.allclose(world, fp.positions[j], atol=1e-4), (fig, joint)
     tip = _world(doc, names["drums_stick_right_tip"], parents, rot)[:3, 3]
     assert np.allclose(tip, pose.sticks[1, 1], atol=1e-4)
+    # the bass leans with its player: its node at keyframe k is the pose's transform, and a
+    # string's nut read from the file is where the leaning bass holds it
+    trans = {
+        ch.target.node: _frames(doc, a.samplers[ch.sampler].output)[k]
+        for a in anims.values()
+        for ch in a.channels
+        if ch.target.path == "translation"
+    }
+    assert not np.allclose(pose.bass_transform, np.eye(4), atol=1e-4)
+    inst = _world(doc, names["bass_instrument"], parents, rot, trans)
+    assert np.allclose(inst, pose.bass_transform, atol=1e-4)
+    nut = _world(doc, names["bass_string_G"], parents, rot, trans)[:3, 3]
+    assert np.allclose(nut, bass_lean.apply(pose.bass_transform, GEOMETRY.bass.nut["G"]), atol=1e-4)
 
 
 def _replan() -> BandAnimator:
@@ -163,5 +185,7 @@ def test_instrument_parts_move(demo_export: Export) -> None:
         "kit_hihat.translation",
         "bass_string_E.weights",
         "bass_string_G.weights",
+        "bass_instrument.rotation",
+        "bass_instrument.translation",
     ):
         assert moving[key] > 1e-3, key

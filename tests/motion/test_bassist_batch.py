@@ -14,16 +14,23 @@ import pytest
 from tests.conftest import DEMO_MID
 from tests.motion.helpers import bass
 from tests.motion.test_band_batch import _animate
+from virja import quat
 from virja.events import NoteOff
 from virja.geometry import GEOMETRY
-from virja.motion import quat
+from virja.motion import bass_lean
 from virja.motion.band import BandAnimator
 from virja.motion.bassist import (
     _ARM_LEN,
     _ARMS,
     _FORES,
     _HANDS,
+    _LTIP,
     _SHOULDERS,
+    BOARD_HALF_WIDTH_M,
+    CHEST,
+    POLE_PUSH_MAX_M,
+    POLE_PUSH_PER_M,
+    WRIST_BESIDE_M,
     Bassist,
     _two_bone,
 )
@@ -61,6 +68,43 @@ def _plain_torso(loc: np.ndarray, sway: float, dip: float, turn: float) -> np.nd
     return out
 
 
+def _plain_wrist_beside_board(
+    b: Bassist, wrist: np.ndarray, tip: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    n = b.neck
+    rel = wrist - tip
+    length = float(np.linalg.norm(rel))
+    need = BOARD_HALF_WIDTH_M + WRIST_BESIDE_M
+    if float(n.coords(wrist)[1]) >= need or length < 1e-9:
+        return wrist, quat.identity()
+    d_lat = min(need - float(n.coords(tip)[1]), length)
+    other = rel - (rel @ n.lateral) * n.lateral
+    norm = float(np.linalg.norm(other))
+    other = other / norm if norm > 1e-9 else n.face
+    new = d_lat * n.lateral + math.sqrt(max(length**2 - d_lat**2, 0.0)) * other
+    return tip + new, quat.from_two_vectors(rel, new)
+
+
+def _plain_reach_with_shoulder(
+    b: Bassist, out: np.ndarray, pos: np.ndarray, rot: np.ndarray, wrist: np.ndarray
+) -> bool:
+    s = b.settings
+    clav, shoulder = pos[_SHOULDERS[0]], pos[_ARMS[0]]
+    excess = float(np.linalg.norm(wrist - shoulder)) - s.shoulder_slack_m
+    if excess <= 0.0:
+        return False
+    bone = shoulder - clav
+    axis = np.cross(bone, wrist - clav)
+    n = float(np.linalg.norm(axis))
+    if n < 1e-12:
+        return False
+    angle = min(excess / float(np.linalg.norm(bone)), s.shoulder_max_rad)
+    world = quat.multiply(quat.from_axis_angle(axis / n, angle), rot[_SHOULDERS[0]])
+    parent = int(_SK.parents[_SHOULDERS[0]])
+    out[_SHOULDERS[0]] = quat.multiply(quat.conjugate(rot[parent]), world)
+    return True
+
+
 def plain_body(
     b: Bassist, loc: np.ndarray, root: np.ndarray, t: float, beat_phase: float, beat_index: int
 ) -> np.ndarray:
@@ -75,32 +119,51 @@ def plain_body(
     two = (beat_index % 2 + beat_phase) / 2.0
     sway = s.sway_rad * loud * math.sin(2 * math.pi * two)
     dip = s.dip_rad * loud * math.sin(math.pi * beat_phase) ** 2
-    turn = s.turn_rad_per_m * (b.geometry.bass.fret_distance(held.fret) if held else 0.0)
+    # the chest turns with where the fingertip is along the neck while a stopped note is held
+    down = 0.0
+    if held is not None:
+        down = min(max(float(b.neck.coords(wpos[_LTIP])[0]), 0.0), b.neck.length)
+    turn = s.turn_rad_per_m * down
     targets = wpos[_HANDS].copy()
+    hand_rot = wrot[_HANDS].copy()
+    targets[0], turn_hand = _plain_wrist_beside_board(b, wpos[_HANDS[0]], wpos[_LTIP])
+    hand_rot[0] = quat.multiply(turn_hand, hand_rot[0])
     targets[0] += _plain_vibrato(b, t)
-    out = _plain_torso(loc, sway, dip, turn)
-    moved_pos, moved_rot = _SK.fk(out, root)
+    endpin = b.geometry.bass.endpin
+
+    def posed(k: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        out = _plain_torso(loc, k * sway, k * dip, k * turn)
+        pos, rot = _SK.fk(out, root)
+        q = b.lean(pos[CHEST], wpos[CHEST])
+        return out, pos, rot, q, bass_lean.apply(bass_lean.matrix(q, endpin), targets)
+
+    out, moved_pos, moved_rot, q, leaned = posed(1.0)
     reach = _ARM_LEN[0] + _ARM_LEN[1] - 1e-3
     k = 1.0
     for i in range(2):
         s0, s1 = wpos[_ARMS[i]], moved_pos[_ARMS[i]]
-        if np.linalg.norm(targets[i] - s1) > reach:
+        t0, t1 = targets[i], leaned[i]
+        if np.linalg.norm(t1 - s1) > reach:
             lo, hi = 0.0, 1.0
             for _ in range(12):
                 mid = 0.5 * (lo + hi)
-                if np.linalg.norm(targets[i] - (s0 + mid * (s1 - s0))) > reach:
+                if np.linalg.norm(t0 + mid * (t1 - t0) - (s0 + mid * (s1 - s0))) > reach:
                     hi = mid
                 else:
                     lo = mid
             k = min(k, lo)
     if k < 1.0:
-        out = _plain_torso(loc, k * sway, k * dip, k * turn)
+        out, moved_pos, moved_rot, q, leaned = posed(k)
+    if _plain_reach_with_shoulder(b, out, moved_pos, moved_rot, leaned[0]):
         moved_pos, moved_rot = _SK.fk(out, root)
     poles = wpos[_FORES] + (moved_pos[_ARMS] - wpos[_ARMS])
-    upper, lower = _two_bone(moved_pos[_ARMS], targets, poles)
+    across = -float(b.neck.coords(wpos[_LTIP])[1])
+    push = min(max(across, 0.0) * POLE_PUSH_PER_M, POLE_PUSH_MAX_M)
+    poles[0] += push * quat.rotate(q, b.neck.lateral)
+    upper, lower = _two_bone(moved_pos[_ARMS], leaned, poles)
     out[_ARMS] = quat.multiply(quat.conjugate(moved_rot[_SHOULDERS]), upper)
     out[_FORES] = quat.multiply(quat.conjugate(upper), lower)
-    out[_HANDS] = quat.multiply(quat.conjugate(lower), wrot[_HANDS])
+    out[_HANDS] = quat.multiply(quat.conjugate(lower), quat.multiply(q, hand_rot))
     return out
 
 
@@ -164,5 +227,4 @@ def test_table_matches_fretted_lookup(library: MotionLibrary, fret: int) -> None
     for t in np.arange(0.0, 11.0, 0.1):
         i = np.searchsorted(tab.impact, [t], side="right")
         held = b.fretted(float(t))
-        want = GEOMETRY.bass.fret_distance(held.fret) if held else 0.0
-        assert tab.fretted_down(i)[0] == want
+        assert tab.has_fretted(i)[0] == (held is not None)

@@ -28,6 +28,7 @@ from virja.render.scene import (
     STICK,
     STRING,
     STRING_HOT,
+    _bass_static,
     _limb_color,
     band_scene,
 )
@@ -57,6 +58,12 @@ def plain_band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     dl.add("cylinder", segment_transforms([axle], [ball], 0.006), CHROME)
     dl.add("sphere", sphere_transforms([ball], BEATER_BALL_M), BEATER)
     dl.add("box", boards, CHROME)
+    # the bass, leaning with its player: its parts in its own frame, moved as one
+    own = DrawList()
+    _bass_static(own, geo)
+    for kind in own.models:
+        for models, colors in zip(own.models[kind], own.colors[kind], strict=True):
+            dl.add(kind, pose.bass_transform @ models, colors)
     return dl
 
 
@@ -115,17 +122,27 @@ def _strings(dl: DrawList, geo: Geometry, pose: BandPose, segments: int = 12) ->
         amp = float(pose.string_vibration.get(s, 0.0))
         radius = 0.0022 - 0.0003 * k
         if amp <= 1e-5:
-            dl.add("cylinder", segment_transforms([a], [z], radius), STRING)
+            dl.add("cylinder", segment_transforms(*_leaned(pose, [a], [z]), radius), STRING)
             continue
         fret = int(pose.string_stops.get(s, 0))
         stop = b.string_point(s, min(max(fret, 0), b.max_fret))
-        dl.add("cylinder", segment_transforms([a], [stop], radius), STRING)
+        dl.add("cylinder", segment_transforms(*_leaned(pose, [a], [stop]), radius), STRING)
         u = np.linspace(0.0, 1.0, segments + 1)[:, None]
         pts = stop + u * (z - stop)
         # the fundamental mode of the vibrating part, swinging at a visible rate
         swing = np.cos(2 * np.pi * (9.0 + 1.3 * k) * pose.time_s)
         pts = pts + lateral * (amp * np.sin(np.pi * u) * swing)
-        dl.add("cylinder", segment_transforms(pts[:-1], pts[1:], radius * 1.3), STRING_HOT)
+        dl.add(
+            "cylinder",
+            segment_transforms(*_leaned(pose, pts[:-1], pts[1:]), radius * 1.3),
+            STRING_HOT,
+        )
+
+
+def _leaned(pose: BandPose, a: Any, z: Any) -> tuple[F64, F64]:
+    """Segment ends moved with the bass (it leans with its player)."""
+    m = pose.bass_transform
+    return np.asarray(a) @ m[:3, :3].T + m[:3, 3], np.asarray(z) @ m[:3, :3].T + m[:3, 3]
 
 
 def _fingers(dl: DrawList, fig: FigurePose, bones: F64) -> None:
@@ -186,3 +203,4 @@ def test_band_scene_equals_the_plain_one(poses: list[BandPose]) -> None:
     # the poses exercise every moving part
     assert lit > 5 and swung > 5 and vibrating > 5
     assert any(len(p.bass_fingers) for p in poses)  # the bassist's fingers drawn too
+    assert any(not np.allclose(p.bass_transform, np.eye(4)) for p in poses)  # the bass leans

@@ -128,6 +128,7 @@ def sample(
             s: np.array([p.string_vibration.get(s, 0.0) for p in poses]) for s in BASS_STRINGS
         },
         origin_s=origin_s,
+        bass_transform=np.array([p.bass_transform for p in poses]),
     )
 
 

@@ -17,7 +17,8 @@ Layout of the file (names are stable; tools may look them up):
   (``kit_ride``, ``kit_crash``, ``kit_hihat`` rotate), the hi-hat's top cymbal
   rises as the left foot lets the pedal up, the pedal boards ``kit_pedal_kick``
   and ``kit_pedal_hihat`` follow the feet;
-- the bass: ``bass_instrument`` and its strings ``bass_string_<E|A|D|G>``,
+- the bass: ``bass_instrument`` (rotated and moved as it leans with its player,
+  about its endpin) and its strings ``bass_string_<E|A|D|G>``,
   whose one morph target (the fundamental mode) is weighted by the vibration;
 - one animation ``band`` (both figures, the kit, the strings), keyframed at
   the export rate, linear (one clip, so importers that play one animation at
@@ -85,6 +86,8 @@ class Sampled:
     - ``hihat_down``: (m,) 0 (pedal up) .. 1 (pressed), from the left foot (None:
       ``1 - hihat_open``);
     - ``origin_s``: the session time of the input's start (what users call 0).
+    - ``bass_transform``: (m, 4, 4) the upright bass's world transform, leaning with
+      its player (``BandPose.bass_transform``; None: it stands still).
     """
 
     times: F64
@@ -96,6 +99,7 @@ class Sampled:
     string_vibration: dict[str, F64]
     hihat_down: F64 | None = None
     origin_s: float = 0.0
+    bass_transform: F64 | None = None
 
 
 # ---------------------------------------------------------------- unit meshes
@@ -612,6 +616,13 @@ def _upright_bass(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _
     bb = geo.bass
     up = bb.axis
     node = b.node("bass_instrument", stage)
+    if s.bass_transform is not None:  # it leans with its player: a rotation about its endpin
+        m = np.asarray(s.bass_transform, dtype=np.float64)
+        rot = quat.from_matrix(m[:, :3, :3])
+        b.doc["nodes"][node]["rotation"] = _xyzw(quat.normalize(rot[0]))
+        b.doc["nodes"][node]["translation"] = [float(x) for x in m[0, :3, 3]]
+        anim.channel(node, "rotation", rot)
+        anim.channel(node, "translation", m[:, :3, 3])
     o = _orient(geo)
     for label, c, sc in (
         ("lower_bout", bb.body_centre - 0.22 * up, [bb.body_width / 2, 0.34, bb.body_depth / 2]),

@@ -24,7 +24,8 @@ import numpy as np
 from virja import quat
 from virja.events import Beat
 from virja.geometry import GEOMETRY, Geometry
-from virja.motion.bassist import Bassist, BassistSettings
+from virja.motion import bass_lean
+from virja.motion.bassist import CHEST, Bassist, BassistSettings
 from virja.motion.clip import Clip, MotionLibrary, UnknownMotionError, default_library
 from virja.motion.drummer_body import BodySettings, DrummerBody
 from virja.motion.drummer_hands import DrummerHands, HandSettings
@@ -168,6 +169,8 @@ class BandAnimator:
         self.hands = DrummerHands(self._roots[0], self.idle["drums"].rotations[0], hands)
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
+        # where the bassist's chest stands when he stands still (the bass leans from there)
+        self._bass_rest_chest = _SK.fk(self.idle["bass"].rotations[0], self._roots[1])[0][CHEST]
         self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
         self.articulations: dict[int, str | None] = default_articulations()
 
@@ -372,6 +375,7 @@ class BandAnimator:
         """The band at ``time_s`` (session seconds)."""
         loc = self.local_rotations(time_s)
         wpos, wrot = _SK.fk(loc, self._roots)
+        lean, fingers = self._bass_parts(time_s, wpos[1])
         figs = [FigurePose(_SK.names, _SK.parents, wpos[i], wrot[i], _SK.radii) for i in range(2)]
         return BandPose(
             time_s=time_s,
@@ -385,7 +389,8 @@ class BandAnimator:
             string_stops=self._stops(time_s),
             fretting_tip=wpos[1, _SK.index("LeftHandEnd")].copy(),
             plucking_tip=wpos[1, _SK.index("RightHandEnd")].copy(),
-            bass_fingers=self.bassist.fingers(time_s, wpos[1]),
+            bass_fingers=fingers,
+            bass_transform=lean,
         )
 
     def local_rotations_many(self, times: np.ndarray) -> np.ndarray:
@@ -464,6 +469,7 @@ class BandAnimator:
         out = []
         for k, t in enumerate(ts.tolist()):
             p, r = wpos[k], wrot[k]
+            lean, fingers = self._bass_parts(t, p[1])
             figs = [FigurePose(_SK.names, _SK.parents, p[i], r[i], _SK.radii) for i in range(2)]
             out.append(
                 BandPose(
@@ -478,10 +484,24 @@ class BandAnimator:
                     string_stops=self._stops(t),
                     fretting_tip=p[1, _SK.index("LeftHandEnd")].copy(),
                     plucking_tip=p[1, _SK.index("RightHandEnd")].copy(),
-                    bass_fingers=self.bassist.fingers(t, p[1]),
+                    bass_fingers=fingers,
+                    bass_transform=lean,
                 )
             )
         return out
+
+    def bass_transform(self, bass_wpos: np.ndarray) -> np.ndarray:
+        """(4, 4) the bass's world transform for the bassist's joint positions (n, 3):
+        leaning with his chest (:mod:`virja.motion.bass_lean`)."""
+        q = self.bassist.lean(bass_wpos[CHEST], self._bass_rest_chest)
+        return bass_lean.matrix(q, self.geometry.bass.endpin)
+
+    def _bass_parts(self, t: float, bass_wpos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The bass's transform (4, 4) and the finger bones (laid out in the bass's own
+        frame, then leaned with it)."""
+        m = self.bass_transform(bass_wpos)
+        own = bass_lean.apply(bass_lean.inverse(m), bass_wpos)
+        return m, bass_lean.apply(m, self.bassist.fingers(t, own))
 
     def _hihat_open(self, wpos: np.ndarray, t: float) -> float:
         rise = float(wpos[self._ltoe, 1]) - self._hihat_pressed_y

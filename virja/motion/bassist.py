@@ -18,6 +18,10 @@ impact; this module adds what the clips do not carry:
   fretting hand as it moves down the neck; larger for louder notes.  The arms
   are solved again afterwards (:func:`virja.motion.ik.two_bone`) so both hands
   stay exactly where the clips put them: contact and timing do not change.
+- **The bass leaning with him** (:mod:`virja.motion.bass_lean`): the instrument
+  turns about its endpin with the chest's sway and dip, and both hands go
+  with it (their targets and orientations are leaned before the arms are
+  solved), so in the bass's own frame nothing of the contact changes.
 
 Pure functions of the notes given and the time asked; numbers in
 ``motions/animation.toml`` ``[bassist]``.
@@ -33,6 +37,7 @@ import numpy as np
 
 from virja import quat
 from virja.geometry import Geometry
+from virja.motion import bass_lean
 from virja.motion.skeleton import SKELETON
 from virja.vocab import BassPluck, MotionKey
 
@@ -60,11 +65,14 @@ class BassistSettings:
     sway_rad: float = 0.03  # hips: weight from foot to foot over two beats
     dip_rad: float = 0.035  # spine: forward on each beat
     turn_rad_per_m: float = 0.25  # chest: toward the fretting hand, per metre down the neck
+    shoulder_slack_m: float = 0.48  # the fretting shoulder reaches toward a wrist farther...
+    shoulder_max_rad: float = 0.45  # ...than this, turning its collarbone at most this much
     thumb_position_fret: int = 12
     vibrato_m: float = 0.003  # left hand rolling along the string on a long note
     vibrato_hz: float = 5.0
     vibrato_after_s: float = 0.25  # it starts this long after the impact
     long_note_s: float = 0.45  # notes at least this long get vibrato
+    lean_follow: float = 0.8  # the bass's contact point follows this much of the chest's move
 
 
 @dataclass
@@ -84,6 +92,65 @@ _ARMS = [_SK.index("LeftArm"), _SK.index("RightArm")]
 _FORES = [_SK.index("LeftForeArm"), _SK.index("RightForeArm")]
 _HANDS = [_SK.index("LeftHand"), _SK.index("RightHand")]
 _SHOULDERS = [_SK.index("LeftShoulder"), _SK.index("RightShoulder")]
+CHEST = _SK.index("Chest")
+_LTIP = _SK.index("LeftHandEnd")
+
+# the fingerboard as render.scene draws it (a 7 cm board, its face 4 mm behind the strings,
+# the neck 3 cm deep behind them)
+BOARD_HALF_WIDTH_M = 0.035
+BOARD_FACE_M = -0.004
+BOARD_BACK_M = -0.030
+WRIST_BESIDE_M = 0.005  # the fretting wrist beside the board's E edge, this far out
+WRIST_OVER_MAX_M = 0.010  # at most this far over it, where the hand cannot reach round
+# the fretting elbow's pole pushed toward the E side as the fingertip goes toward the G
+# side (m of push per m the tip is past the board's centre line), up to POLE_PUSH_MAX_M
+POLE_PUSH_PER_M = 12.0
+POLE_PUSH_MAX_M = 0.6
+
+
+@dataclass(frozen=True)
+class NeckFrame:
+    """The fingerboard's frame in the bass's own frame: ``nut`` (3,) the centre of the
+    nut; ``along`` toward the bridge, ``lateral`` toward the E side, ``face`` out of the
+    board toward the strings (unit (3,)); ``length`` of the board (m)."""
+
+    nut: np.ndarray
+    along: np.ndarray
+    lateral: np.ndarray
+    face: np.ndarray
+    length: float
+
+    def coords(self, points: np.ndarray) -> np.ndarray:
+        """(..., 3) -> (..., 3) (along, lateral, face) of points, m from the nut's centre."""
+        rel = np.asarray(points, dtype=np.float64) - self.nut
+        return np.stack([rel @ self.along, rel @ self.lateral, rel @ self.face], axis=-1)
+
+
+def neck_frame(geometry: Geometry) -> NeckFrame:
+    """The fingerboard as render.scene draws it, along the middle four strings."""
+    b = geometry.bass
+    four = [s for s in b.strings if s in ("E", "A", "D", "G")]
+    nut = np.mean([b.nut[s] for s in four], axis=0)
+    bridge = np.mean([b.bridge[s] for s in four], axis=0)
+    along = bridge - nut
+    length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
+    along = along / np.linalg.norm(along)
+    face = b.front - np.dot(b.front, along) * along
+    face = face / np.linalg.norm(face)
+    return NeckFrame(nut, along, np.cross(face, along), face, length)
+
+
+def forearm_over_board_m(neck: NeckFrame, elbow: np.ndarray, wrist: np.ndarray) -> np.ndarray:
+    """How far (m, >= 0) the forearms (..., 3) elbow -> wrist reach over the fingerboard's
+    E edge in front of the neck's back (0: the forearm stays behind the neck or beside it);
+    a forearm through the neck counts its whole overlap."""
+    u = np.linspace(0.0, 1.0, 17)[:, None]
+    e = np.asarray(elbow, dtype=np.float64)[..., None, :]
+    w = np.asarray(wrist, dtype=np.float64)[..., None, :]
+    c = neck.coords(e + u * (w - e))  # (..., 17, 3)
+    by_board = (c[..., 0] > 0.0) & (c[..., 0] < neck.length) & (c[..., 2] > BOARD_BACK_M)
+    over = np.where(by_board, BOARD_HALF_WIDTH_M - c[..., 1], 0.0)
+    return np.asarray(np.clip(over, 0.0, None).max(axis=-1))
 
 
 def _frames(direction: np.ndarray, hinge: np.ndarray) -> np.ndarray:
@@ -151,6 +218,7 @@ class Bassist:
         b = geometry.bass
         lateral = np.cross(b.axis, b.front)
         self._lateral = lateral / np.linalg.norm(lateral)  # toward the low strings
+        self.neck = neck_frame(geometry)
 
     # -- input ------------------------------------------------------------------
 
@@ -368,9 +436,86 @@ class Bassist:
         sway = s.sway_rad * loud * np.sin(2 * np.pi * two)
         dip = s.dip_rad * loud * np.sin(np.pi * phase) ** 2
         # the chest turns with the fretting hand: lower on the neck, further toward the bass
-        turn = s.turn_rad_per_m * tab.fretted_down(i)
-        out[rows] = self._moved(loc, root, sway, dip, turn, self._vibrato_many(t, last))
+        # (where the fingertip is along the neck: it moves on continuously between notes)
+        held = tab.has_fretted(i)
+        out[rows] = self._moved(loc, root, sway, dip, held, self._vibrato_many(t, last))
         return out
+
+    def lean(self, chest: np.ndarray, rest_chest: np.ndarray) -> np.ndarray:
+        """The bass's lean (..., 4) for the chest at ``chest`` (..., 3) (see
+        :mod:`virja.motion.bass_lean`; ``rest_chest`` where it stands still)."""
+        return bass_lean.lean(chest, rest_chest, self.geometry.bass, self.settings.lean_follow)
+
+    def _wrist_beside_board(
+        self, wrist: np.ndarray, tip: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The fretting wrists (m, 3) moved round their fingertips (m, 3) (the hand turned
+        about the tip, the tip kept) to lie beside the fingerboard's E edge, or as near it
+        as the hand reaches; and the turns (m, 4) of the hands.  A wrist already beside
+        the board stays."""
+        n = self.neck
+        rel = wrist - tip
+        length = np.linalg.norm(rel, axis=-1)
+        need = BOARD_HALF_WIDTH_M + WRIST_BESIDE_M
+        move = (n.coords(wrist)[:, 1] < need) & (length >= 1e-9)
+        turn = quat.identity((len(wrist),))
+        if not move.any():
+            return wrist, turn
+        rel, length, tip = rel[move], length[move], tip[move]
+        d_lat = np.minimum(need - n.coords(tip)[:, 1], length)
+        other = rel - (rel @ n.lateral)[:, None] * n.lateral
+        norm = np.linalg.norm(other, axis=-1)
+        ok = norm > 1e-9
+        other = np.where(ok[:, None], other / np.where(ok, norm, 1.0)[:, None], n.face)
+        side = np.sqrt(np.maximum(length**2 - d_lat**2, 0.0))
+        new = d_lat[:, None] * n.lateral + side[:, None] * other
+        out = wrist.copy()
+        out[move] = tip + new
+        turn[move] = quat.from_two_vectors(rel, new)
+        return out, turn
+
+    def _posed(
+        self,
+        loc: np.ndarray,
+        root: np.ndarray,
+        rest_chest: np.ndarray,
+        targets: np.ndarray,
+        motion: tuple[np.ndarray, np.ndarray, np.ndarray],
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The torso moved by ``motion`` (sway, dip, turn (m,)), its FK, the bass leaning
+        with the chest (m, 4) and the hands' targets (m, 2, 3) leaned with it."""
+        out = _torso(loc, *motion)
+        pos, rot = _SK.fk_matrices(out, root)
+        q = self.lean(pos[:, CHEST], rest_chest)
+        m = bass_lean.matrix(q, self.geometry.bass.endpin)
+        leaned = np.einsum("mij,mkj->mki", m[:, :3, :3], targets) + m[:, None, :3, 3]
+        return out, pos, rot, q, leaned
+
+    def _reach_with_shoulder(
+        self, out: np.ndarray, pos: np.ndarray, rot: np.ndarray, wrist: np.ndarray
+    ) -> np.ndarray:
+        """Turn the left collarbone of ``out`` (m, n, 4; in place) toward ``wrist`` (m, 3)
+        by as much as the shoulder is farther than ``shoulder_slack_m`` from it (bounded);
+        the frames (indices) where it turned."""
+        s = self.settings
+        clav, shoulder = pos[:, _SHOULDERS[0]], pos[:, _ARMS[0]]
+        excess = np.linalg.norm(wrist - shoulder, axis=-1) - s.shoulder_slack_m
+        bone = shoulder - clav
+        axis = np.cross(bone, wrist - clav)
+        n = np.linalg.norm(axis, axis=-1)
+        rows = np.nonzero((excess > 0.0) & (n >= 1e-12))[0]
+        if rows.size == 0:
+            return rows
+        angle = np.minimum(excess[rows] / np.linalg.norm(bone[rows], axis=-1), s.shoulder_max_rad)
+        world = quat.multiply(
+            quat.from_axis_angle(axis[rows] / n[rows, None], angle),
+            quat.from_matrix(rot[rows, _SHOULDERS[0]]),
+        )
+        parent = int(_SK.parents[_SHOULDERS[0]])
+        out[rows, _SHOULDERS[0]] = quat.multiply(
+            quat.conjugate(quat.from_matrix(rot[rows, parent])), world
+        )
+        return rows
 
     def _vibrato_many(self, t: np.ndarray, last: np.ndarray) -> np.ndarray:
         """:meth:`_vibrato` at times ``t`` (m,) whose latest note is ``last`` (m,): (m, 3)."""
@@ -399,47 +544,69 @@ class Bassist:
         root: np.ndarray,
         sway: np.ndarray,
         dip: np.ndarray,
-        turn: np.ndarray,
+        held: np.ndarray,
         vibrato: np.ndarray,
     ) -> np.ndarray:
         wpos, wrot = _SK.fk_matrices(loc, root)
+        neck_tip = self.neck.coords(wpos[:, _LTIP])  # (m, 3) along, lateral, face
+        down = np.where(held, np.clip(neck_tip[:, 0], 0.0, self.neck.length), 0.0)
+        turn = self.settings.turn_rad_per_m * down
         targets = wpos[:, _HANDS].copy()
+        hand_rot = quat.from_matrix(wrot[:, _HANDS])
+        # the fretting wrist beside the board's E edge, so the forearm stays behind the neck
+        targets[:, 0], turn_hand = self._wrist_beside_board(wpos[:, _HANDS[0]], wpos[:, _LTIP])
+        hand_rot[:, 0] = quat.multiply(turn_hand, hand_rot[:, 0])
         targets[:, 0] += vibrato
-        out = _torso(loc, sway, dip, turn)
-        moved_pos, moved_rot = _SK.fk_matrices(out, root)
+        rest_chest = wpos[:, CHEST]
+        out, moved_pos, moved_rot, q, leaned = self._posed(
+            loc, root, rest_chest, targets, (sway, dip, turn)
+        )
         # less of it where an arm near full stretch could no longer keep its hand in place:
-        # the largest share k of the motion (shoulders move about linearly with it) that
-        # leaves both wrists within reach
+        # the largest share k of the motion (shoulders and the leaned targets move about
+        # linearly with it) that leaves both wrists within reach
         reach = _ARM_LEN[0] + _ARM_LEN[1] - 1e-3
         k = np.ones(len(loc))
         for i in range(2):
             s0, s1 = wpos[:, _ARMS[i]], moved_pos[:, _ARMS[i]]
-            far = np.nonzero(np.linalg.norm(targets[:, i] - s1, axis=-1) > reach)[0]
+            far = np.nonzero(np.linalg.norm(leaned[:, i] - s1, axis=-1) > reach)[0]
             if far.size == 0:
                 continue
             lo, hi = np.zeros(far.size), np.ones(far.size)
-            a, b, goal = s0[far], s1[far] - s0[far], targets[far, i]
+            a, b = s0[far], s1[far] - s0[far]
+            g, dg = targets[far, i], leaned[far, i] - targets[far, i]
             for _ in range(12):
-                mid = 0.5 * (lo + hi)
-                out_of_reach = np.linalg.norm(goal - (a + mid[:, None] * b), axis=-1) > reach
-                hi = np.where(out_of_reach, mid, hi)
-                lo = np.where(out_of_reach, lo, mid)
+                mid = 0.5 * (lo + hi)[:, None]
+                out_of_reach = np.linalg.norm(g + mid * dg - (a + mid * b), axis=-1) > reach
+                hi = np.where(out_of_reach, mid[:, 0], hi)
+                lo = np.where(out_of_reach, lo, mid[:, 0])
             k[far] = np.minimum(k[far], lo)
         less = np.nonzero(k < 1.0)[0]
         if less.size:
             kl = k[less]
-            out[less] = _torso(loc[less], kl * sway[less], kl * dip[less], kl * turn[less])
-            moved_pos[less], moved_rot[less] = _SK.fk_matrices(out[less], root)
+            motion = (kl * sway[less], kl * dip[less], kl * turn[less])
+            o, p, r, ql, tl = self._posed(loc[less], root, rest_chest[less], targets[less], motion)
+            out[less], moved_pos[less], moved_rot[less], q[less], leaned[less] = o, p, r, ql, tl
+        # the fretting shoulder follows its hand: in the high positions the collarbone turns
+        # toward the wrist, so the arm is not stretched straight and its elbow can stay out
+        # behind the neck (the chest, and so the bass's lean, are unchanged)
+        turned = self._reach_with_shoulder(out, moved_pos, moved_rot, leaned[:, 0])
+        if turned.size:
+            moved_pos[turned], moved_rot[turned] = _SK.fk_matrices(out[turned], root)
         poles = wpos[:, _FORES] + (moved_pos[:, _ARMS] - wpos[:, _ARMS])
+        # the fretting elbow out to the E side as the fingertip reaches toward the G side
+        # (the forearm comes round behind the neck, not across the board)
+        push = np.minimum(np.maximum(-neck_tip[:, 1], 0.0) * POLE_PUSH_PER_M, POLE_PUSH_MAX_M)
+        poles[:, 0] += push[:, None] * quat.rotate(q, self.neck.lateral)
         m = len(loc)
         upper, lower = _two_bone(
-            moved_pos[:, _ARMS].reshape(-1, 3), targets.reshape(-1, 3), poles.reshape(-1, 3)
+            moved_pos[:, _ARMS].reshape(-1, 3), leaned.reshape(-1, 3), poles.reshape(-1, 3)
         )
         upper, lower = upper.reshape(m, 2, 4), lower.reshape(m, 2, 4)
         shoulders = quat.from_matrix(moved_rot[:, _SHOULDERS])
-        hands = quat.from_matrix(wrot[:, _HANDS])
         out[:, _ARMS] = quat.multiply(quat.conjugate(shoulders), upper)
         out[:, _FORES] = quat.multiply(quat.conjugate(upper), lower)
+        # the hands keep their grip on the leaned bass: turned with it
+        hands = quat.multiply(q[:, None], hand_rot)
         out[:, _HANDS] = quat.multiply(quat.conjugate(lower), hands)
         return out
 
@@ -469,7 +636,6 @@ class _NoteTable:
     off: np.ndarray
     velocity: np.ndarray
     fret: np.ndarray
-    down: np.ndarray  # fret distance from the nut (0 for an open string)
     string_dir: np.ndarray  # (k, 3)
     fretted: np.ndarray  # indices of the stopped notes
 
@@ -484,15 +650,13 @@ class _NoteTable:
             off=np.array([n.off for n in notes], dtype=np.float64),
             velocity=np.array([n.velocity for n in notes], dtype=np.float64),
             fret=fret,
-            down=np.array([b.fret_distance(n.fret) if n.fret > 0 else 0.0 for n in notes]),
             string_dir=np.array([dirs[n.string] for n in notes]).reshape(-1, 3),
             fretted=np.nonzero(fret > 0)[0],
         )
 
-    def fretted_down(self, i: np.ndarray) -> np.ndarray:
-        """How far down the neck the hand is at times whose notes struck so far are
-        ``[:i]`` (m,): the latest stopped note among the last 32 (:meth:`Bassist.fretted`)."""
+    def has_fretted(self, i: np.ndarray) -> np.ndarray:
+        """Whether a stopped note is held at times whose notes struck so far are ``[:i]``
+        (m,): one among the last 32 (:meth:`Bassist.fretted`)."""
         k = np.searchsorted(self.fretted, i, side="left") - 1
         j = self.fretted[np.maximum(k, 0)] if self.fretted.size else np.zeros_like(i)
-        found = (k >= 0) & (j >= i - 32)
-        return np.where(found, self.down[j] if self.fretted.size else 0.0, 0.0)
+        return np.asarray((k >= 0) & (j >= i - 32))

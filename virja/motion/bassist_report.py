@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from virja import quat
+from virja.motion import bass_lean
 from virja.motion.band import BandAnimator, PlannedNoteLike
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
@@ -116,15 +117,19 @@ class BassistFigures:
         )
 
 
-def _frames(animator: BandAnimator, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(k, n, 3) bassist joint positions, (k, n, 4) rotations, (k, m, 3) finger points."""
-    pos, rot, fingers = [], [], []
+def _frames(
+    animator: BandAnimator, times: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(k, n, 3) bassist joint positions, (k, n, 4) rotations, (k, m, 3) finger points (world),
+    and (k, n, 3) the joint positions in the bass's own frame (it leans with him)."""
+    pos, rot, fingers, own = [], [], [], []
     for t in times:
         pose = animator.pose(float(t))
         pos.append(pose.bass.positions)
         rot.append(pose.bass.rotations)
         fingers.append(pose.bass_fingers.reshape(-1, 3))
-    return np.array(pos), np.array(rot), np.array(fingers)
+        own.append(bass_lean.apply(bass_lean.inverse(pose.bass_transform), pose.bass.positions))
+    return np.array(pos), np.array(rot), np.array(fingers), np.array(own)
 
 
 def _neck_frame(
@@ -189,28 +194,29 @@ def measure_bassist(
     t0 = min(p.start for p in bass)
     t1 = max(p.impact for p in bass) + 0.6
     fast = t0 + np.arange(int((t1 - t0) * 120) + 1) / 120.0
-    pos120, _, _ = _frames(animator, fast)
+    pos120, _, _, _ = _frames(animator, fast)
     wrists = pos120[:, [_SK.index("LeftHand"), _SK.index("RightHand")]]
     speed = np.linalg.norm(np.diff(wrists, axis=0), axis=-1).ravel() * 120.0
     slow = t0 + np.arange(int((t1 - t0) * 30) + 1) / 30.0
-    pos, rot, fingers = _frames(animator, slow)
+    pos, rot, fingers, own = _frames(animator, slow)
     every = np.concatenate([pos, fingers], axis=1)
     jump = float(np.linalg.norm(np.diff(every, axis=0), axis=-1).max()) if len(slow) > 1 else 0.0
     chest = rot[:, _SK.index("Chest")]
     torso = 0.0
     for i in range(0, len(chest), 3):
         torso = max(torso, float(quat.angle_between(chest[i], chest).max()))
+    # collisions and the fretting side in the bass's own frame (it leans with him)
     u = np.linspace(0.0, 1.0, 9)[:, None, None]
     collide = np.zeros(len(slow), dtype=bool)
     for a, b in SEGMENTS:
-        pa, pb = pos[:, _SK.index(a)], pos[:, _SK.index(b)]
+        pa, pb = own[:, _SK.index(a)], own[:, _SK.index(b)]
         pts = pa[None] + u * (pb - pa)[None]  # (9, k, 3)
         hit = _in_board(pts, animator) | _in_body(pts, animator)
         collide |= hit.any(axis=0)
     nut, _, lateral, front, _ = _neck_frame(animator)
-    wrist = pos[:, _SK.index("LeftHand")] - nut
-    elbow = pos[:, _SK.index("LeftForeArm")] - nut
-    tip = pos[:, _SK.index("LeftHandEnd")] - nut
+    wrist = own[:, _SK.index("LeftHand")] - nut
+    elbow = own[:, _SK.index("LeftForeArm")] - nut
+    tip = own[:, _SK.index("LeftHandEnd")] - nut
     side = (
         (wrist @ lateral > tip @ lateral)
         & (wrist @ lateral > BOARD_HALF_WIDTH_M - 0.01)

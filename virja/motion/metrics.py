@@ -22,6 +22,7 @@ import numpy as np
 
 from virja import quat
 from virja.geometry import Geometry
+from virja.motion import bass_lean
 from virja.motion.band import FIGURES, BandAnimator, PlannedNoteLike, sticks
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
 from virja.vocab import HANDS, PERFORMER_LIMBS, DrumStroke
@@ -95,16 +96,18 @@ def contact_distance(
         toe = wpos[0, _SK.index("RightToe" if p.limb == "right_foot" else "LeftToe")]
         return float(np.linalg.norm(toe - pedal.toe_point(True))), None
     assert p.string is not None
+    # the bass leans with its player (BandPose.bass_transform): the targets lean with it
+    lean = animator.bass_transform(wpos[1])
     pluck = float(
-        np.linalg.norm(wpos[1, _SK.index("RightHandEnd")] - geo.bass.pluck_point(p.string))
+        np.linalg.norm(
+            wpos[1, _SK.index("RightHandEnd")]
+            - bass_lean.apply(lean, geo.bass.pluck_point(p.string))
+        )
     )
     fret = None
     if p.fret:
-        fret = float(
-            np.linalg.norm(
-                wpos[1, _SK.index("LeftHandEnd")] - geo.bass.string_point(p.string, p.fret)
-            )
-        )
+        stop = bass_lean.apply(lean, geo.bass.string_point(p.string, p.fret))
+        fret = float(np.linalg.norm(wpos[1, _SK.index("LeftHandEnd")] - stop))
     return pluck, fret
 
 

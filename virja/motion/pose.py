@@ -61,6 +61,9 @@ class BandPose:
       first (:data:`LEFT_FINGER_BONES`: index, middle, ring, little, two bones
       each, then the thumb's two), then the plucking hand's (index, middle, two
       bones each, ring and little curled, the thumb).
+    - ``bass_transform``: (4, 4) the upright bass's world transform (a rotation
+      about its endpin, :mod:`virja.motion.bass_lean`): the instrument of
+      :mod:`virja.geometry` leans with its player; identity when he stands still.
     """
 
     time_s: float
@@ -75,6 +78,7 @@ class BandPose:
     fretting_tip: np.ndarray
     plucking_tip: np.ndarray
     bass_fingers: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
+    bass_transform: np.ndarray = field(default_factory=lambda: np.eye(4))
 
     def figure(self, performer: str) -> FigurePose:
         """``"drums"`` or ``"bass"``."""

@@ -62,7 +62,8 @@ def add_floor(dl: DrawList, size_m: tuple[float, float]) -> None:
 
 
 def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
-    """The floor, drum shells and stands, the throne, the bass body and neck."""
+    """The floor, drum shells and stands, the throne (the bass leans with its player:
+    it is drawn with what moves, :func:`band_scene`)."""
     dl = DrawList()
     add_floor(dl, geo.stage.floor_size)
     kit = geo.kit
@@ -117,12 +118,40 @@ def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
                     ),
                     CHROME,
                 )
-    # the footboards and the kick's beater move with the feet: band_scene (virja.render.pedals)
-    _bass_static(dl, geo)
+    # the footboards and the kick's beater move with the feet, the bass leans with its
+    # player: both in band_scene (virja.render.pedals, BandPose.bass_transform)
     return dl.freeze()
 
 
+_BASS_TABLES: dict[int, tuple[Geometry, dict[str, tuple[F64, F64]]]] = {}
+
+
+def _bass_table(geo: Geometry) -> dict[str, tuple[F64, F64]]:
+    """The upright bass's instances (models, colours) per kind in its own frame, built once
+    per geometry."""
+    hit = _BASS_TABLES.get(id(geo))
+    if hit is not None and hit[0] is geo:
+        return hit[1]
+    dl = DrawList()
+    _bass_static(dl, geo)
+    table = {k: (np.concatenate(dl.models[k]), np.concatenate(dl.colors[k])) for k in dl.models}
+    _BASS_TABLES[id(geo)] = (geo, table)
+    return table
+
+
+def _bass_instrument(dl: DrawList, geo: Geometry, transform: F64) -> None:
+    """The bass's body, neck, fingerboard, bridge, tailpiece and endpin, leaning as
+    ``transform`` (4, 4) says (``BandPose.bass_transform``)."""
+    m = np.asarray(transform, dtype=np.float64)
+    for kind, (models, colors) in _bass_table(geo).items():
+        dl.add(kind, models if np.array_equal(m, _EYE) else m @ models, colors)
+
+
+_EYE = np.eye(4)
+
+
 def _bass_static(dl: DrawList, geo: Geometry) -> None:
+    """The bass's parts in its own frame (:mod:`virja.geometry`, not leaning)."""
     b = geo.bass
     up = b.axis
     # the body: lower and upper bouts as flattened spheres, a waist between
@@ -229,6 +258,7 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     dl.add("cylinder", np.concatenate([kit_cyl, seg]), np.concatenate([kit_color, seg_color]))
     sph, sph_color = _sphere_rows(parts)
     dl.add("sphere", sph, sph_color)
+    _bass_instrument(dl, geo, pose.bass_transform)
     return dl
 
 
@@ -490,6 +520,10 @@ def _string_parts(geo: Geometry, pose: BandPose, segments: int = 12) -> _Parts:
         z[rows] = pts[:, 1:].reshape(-1, 3)
         radius[rows] = np.repeat(t.radius[v] * 1.3, segments)
         color[rows] = STRING_HOT
+    m = np.asarray(pose.bass_transform, dtype=np.float64)
+    if not np.array_equal(m, _EYE):  # the strings lean with the bass
+        a = a @ m[:3, :3].T + m[:3, 3]
+        z = z @ m[:3, :3].T + m[:3, 3]
     return _Parts([(a, z, radius, color)], [])
 
 

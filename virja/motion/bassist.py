@@ -39,7 +39,7 @@ from virja import quat
 from virja.geometry import Geometry
 from virja.motion import bass_lean
 from virja.motion.skeleton import SKELETON
-from virja.vocab import BassPluck, MotionKey
+from virja.vocab import BASS_STRINGS, BassPluck, MotionKey
 
 _SK = SKELETON
 _ARM_LEN = (
@@ -129,7 +129,7 @@ class NeckFrame:
 def neck_frame(geometry: Geometry) -> NeckFrame:
     """The fingerboard as render.scene draws it, along the middle four strings."""
     b = geometry.bass
-    four = [s for s in b.strings if s in ("E", "A", "D", "G")]
+    four = [s for s in b.strings if s in BASS_STRINGS]
     nut = np.mean([b.nut[s] for s in four], axis=0)
     bridge = np.mean([b.bridge[s] for s in four], axis=0)
     along = bridge - nut

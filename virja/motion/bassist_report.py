@@ -29,14 +29,12 @@ import numpy as np
 from virja import quat
 from virja.motion import bass_lean
 from virja.motion.band import BandAnimator, PlannedNoteLike
+from virja.motion.bassist import BOARD_BACK_M, BOARD_FACE_M, BOARD_HALF_WIDTH_M, neck_frame
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
-from virja.vocab import BASS_STRINGS, BassPluck
+from virja.vocab import BassPluck
 
 _SK = SKELETON
-BOARD_HALF_WIDTH_M = 0.035
-BOARD_FACE_M = -0.004  # the fingerboard's face, behind the strings (render.scene)
-BOARD_BACK_M = -0.030  # the neck's back
 SEGMENTS = (
     ("LeftForeArm", "LeftHand"),
     ("LeftHand", "LeftHandEnd"),
@@ -137,15 +135,8 @@ def _neck_frame(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """(nut centre, along the strings, lateral toward E, out of the board face, board
     length): the fingerboard as render.scene draws it, along the strings."""
-    b = animator.geometry.bass
-    nut = np.mean([b.nut[s] for s in b.strings if s in BASS_STRINGS], axis=0)
-    bridge = np.mean([b.bridge[s] for s in b.strings if s in BASS_STRINGS], axis=0)
-    along = bridge - nut
-    length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
-    along = along / np.linalg.norm(along)
-    face = b.front - np.dot(b.front, along) * along
-    face = face / np.linalg.norm(face)
-    return nut, along, np.cross(face, along), face, length  # lateral: + toward E
+    n = neck_frame(animator.geometry)
+    return n.nut, n.along, n.lateral, n.face, n.length
 
 
 def _in_board(points: np.ndarray, animator: BandAnimator) -> np.ndarray:

@@ -12,13 +12,14 @@ from virja.motion.band import BandAnimator
 from virja.motion.bassist import CHEST
 from virja.motion.clip import MotionLibrary
 from virja.motion.metrics import contact_distance
+from virja.plan.types import PlannedNote
 from virja.render.scene import band_scene, static_scene
 
 LINE = [("E", 3), ("A", 5), ("D", 7), ("G", 9), ("E", 0), ("A", 12), ("G", 5), ("D", 2)]
 
 
 @pytest.fixture(scope="module")
-def played(library: MotionLibrary) -> tuple[BandAnimator, list[object]]:
+def played(library: MotionLibrary) -> tuple[BandAnimator, list[PlannedNote]]:
     a = BandAnimator(library)
     for i in range(16):
         a.add_beat(Beat(0.5 * i, 0, i // 4 + 1, i % 4 + 1, 4, 500_000))
@@ -36,7 +37,7 @@ def _angle_deg(m: np.ndarray) -> float:
 
 
 def test_the_bass_leans_a_little_about_its_endpin_and_stands_still_before_the_music(
-    played: tuple[BandAnimator, list[object]],
+    played: tuple[BandAnimator, list[PlannedNote]],
 ) -> None:
     a, _ = played
     endpin = a.geometry.bass.endpin
@@ -57,7 +58,7 @@ def test_the_bass_leans_a_little_about_its_endpin_and_stands_still_before_the_mu
 
 
 def test_fingers_stay_on_the_leaning_strings_at_every_impact(
-    played: tuple[BandAnimator, list[object]],
+    played: tuple[BandAnimator, list[PlannedNote]],
 ) -> None:
     a, notes = played
     leaned = 0
@@ -65,8 +66,8 @@ def test_fingers_stay_on_the_leaning_strings_at_every_impact(
         pluck, fretting = contact_distance(a, p, p.impact)  # against the leaned strings
         assert pluck < 0.002 and (fretting is None or fretting < 0.002), p
         pose = a.pose(p.impact)
-        if p.fret:  # type: ignore[attr-defined]
-            still = a.geometry.bass.string_point(p.string, p.fret)  # type: ignore[attr-defined]
+        if p.fret:
+            still = a.geometry.bass.string_point(str(p.string), p.fret)
             leaned += float(np.linalg.norm(pose.fretting_tip - still)) > 0.002
             # the stopping finger's tip is the fretting fingertip (it leans with the hand)
             tips = pose.bass_fingers[1:8:2, 1]
@@ -75,7 +76,7 @@ def test_fingers_stay_on_the_leaning_strings_at_every_impact(
 
 
 def test_the_instrument_is_drawn_where_the_pose_leans_it(
-    played: tuple[BandAnimator, list[object]],
+    played: tuple[BandAnimator, list[PlannedNote]],
 ) -> None:
     a, _ = played
     pose = max(a.poses(np.arange(0.75, 4.75, 0.1)), key=lambda p: _angle_deg(p.bass_transform))

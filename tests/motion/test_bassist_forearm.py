@@ -57,7 +57,7 @@ def test_the_forearm_stays_behind_the_neck_over_the_whole_grid(
         elbow = own[SKELETON.index("LeftForeArm")]
         wrist = own[SKELETON.index("LeftHand")]
         over = float(forearm_over_board_m(neck, elbow, wrist))
-        worst[current] = max(worst.get(current, 0.0), over)  # type: ignore[index]
+        worst[current] = max(worst.get(current, 0.0), over)
         # the elbow out behind the neck, on its E side
         assert neck.coords(elbow)[2] < -0.05, (tuning, current, pose.time_s)
         assert neck.coords(elbow)[1] > BOARD_HALF_WIDTH_M, (tuning, current, pose.time_s)

@@ -129,3 +129,35 @@ def test_the_window_process_plays_and_draws_the_tuning_it_is_sent(tmp_path: Path
     assert sum(len(m) for m in drawn.models["cylinder"]) > sum(
         len(m) for m in four.models["cylinder"]
     )
+
+
+def test_live_outputs_tell_the_web_animator_and_the_window_the_tuning(
+    tmp_path: Path, monkeypatch: Any
+) -> None:
+    """Through the pipeline builder and the live outputs (serve, replay, jam): the web
+    feed's own animator and the window (its queue) both learn the five strings."""
+    import virja.live.viewer as viewer_module
+    from virja.live.outputs import LiveOutputs, LiveSettings, WebSettings
+    from virja.pipeline import PerformanceSettings, build_performance
+
+    sent: list[tuple[Any, ...]] = []
+
+    def queue_only(self: Viewer, *args: Any, **kwargs: Any) -> None:
+        self._shut = False  # no process: only the queue side is under test
+        self._inbox = type("Q", (), {"put": staticmethod(sent.append)})()
+
+    monkeypatch.setattr(viewer_module.Viewer, "__init__", queue_only)
+    monkeypatch.setattr(viewer_module.Viewer, "close", lambda self: None)
+    path = tmp_path / "five.toml"
+    path.write_text('[plan]\nbass_tuning = "five"\n')
+    perf = build_performance(PerformanceSettings(plan=load_plan_config(path)))
+    window: Any = object()  # the window's settings: unused by the queue-only viewer
+    settings = LiveSettings(window=window, web=WebSettings(port=0))
+    outputs = LiveOutputs.open(perf, settings, lambda: 1000.0)
+    try:
+        web_animator, viewer = outputs.sinks.sinks
+        assert isinstance(web_animator, BandAnimator) and viewer is outputs.viewer
+        assert web_animator.bass_strings == FIVE
+        assert ("strings", FIVE) in sent
+    finally:
+        outputs.close()

@@ -375,7 +375,7 @@ class BandAnimator:
         """The band at ``time_s`` (session seconds)."""
         loc = self.local_rotations(time_s)
         wpos, wrot = _SK.fk(loc, self._roots)
-        lean, fingers = self._bass_parts(time_s, wpos[1])
+        lean, fingers = self._bass_parts(time_s, wpos[1], self.bass_transform(wpos[1]))
         figs = [FigurePose(_SK.names, _SK.parents, wpos[i], wrot[i], _SK.radii) for i in range(2)]
         return BandPose(
             time_s=time_s,
@@ -466,10 +466,11 @@ class BandAnimator:
         loc = self.local_rotations_many(ts) if local is None else local
         wpos, wrot = _SK.fk(loc, self._roots)
         all_sticks = sticks(wpos[:, 0], wrot[:, 0])
+        leans = self.bass_transform(wpos[:, 1])  # (m, 4, 4), one pass
         out = []
         for k, t in enumerate(ts.tolist()):
             p, r = wpos[k], wrot[k]
-            lean, fingers = self._bass_parts(t, p[1])
+            lean, fingers = self._bass_parts(t, p[1], leans[k])
             figs = [FigurePose(_SK.names, _SK.parents, p[i], r[i], _SK.radii) for i in range(2)]
             out.append(
                 BandPose(
@@ -491,15 +492,16 @@ class BandAnimator:
         return out
 
     def bass_transform(self, bass_wpos: np.ndarray) -> np.ndarray:
-        """(4, 4) the bass's world transform for the bassist's joint positions (n, 3):
-        leaning with his chest (:mod:`virja.motion.bass_lean`)."""
-        q = self.bassist.lean(bass_wpos[CHEST], self._bass_rest_chest)
+        """(..., 4, 4) the bass's world transform for the bassist's joint positions
+        (..., n, 3): leaning with his chest (:mod:`virja.motion.bass_lean`)."""
+        q = self.bassist.lean(bass_wpos[..., CHEST, :], self._bass_rest_chest)
         return bass_lean.matrix(q, self.geometry.bass.endpin)
 
-    def _bass_parts(self, t: float, bass_wpos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The bass's transform (4, 4) and the finger bones (laid out in the bass's own
-        frame, then leaned with it)."""
-        m = self.bass_transform(bass_wpos)
+    def _bass_parts(
+        self, t: float, bass_wpos: np.ndarray, m: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The bass's transform ``m`` (4, 4) and the finger bones (laid out in the bass's
+        own frame, then leaned with it)."""
         own = bass_lean.apply(bass_lean.inverse(m), bass_wpos)
         return m, bass_lean.apply(m, self.bassist.fingers(t, own))
 

@@ -13,7 +13,7 @@ from virja.motion.bassist import CHEST
 from virja.motion.clip import MotionLibrary
 from virja.motion.metrics import contact_distance
 from virja.plan.types import PlannedNote
-from virja.render.scene import band_scene, static_scene
+from virja.render.scene import _bass_table, band_scene, static_scene
 
 LINE = [("E", 3), ("A", 5), ("D", 7), ("G", 9), ("E", 0), ("A", 12), ("G", 5), ("D", 2)]
 
@@ -83,9 +83,11 @@ def test_the_instrument_is_drawn_where_the_pose_leans_it(
     still = band_scene(a.pose(0.0))
     moved = band_scene(pose)
     # the body, neck and fingerboard move with the lean (boxes: the waist, the fingerboard,
-    # the bridge and the tailpiece), and the stage no longer carries them
-    assert "box" in moved.models and len(static_scene().packed("box")) == 3  # floor, pedals
-    boxes_still = np.concatenate(still.models["box"])
-    boxes_moved = np.concatenate(moved.models["box"])
+    # the bridge and the tailpiece, drawn after the footboards), and the stage no longer
+    # carries them
+    assert "box" in moved.models and len(static_scene().packed("box")) == 1  # the floor
+    n = len(_bass_table(a.geometry)["box"][0])
+    boxes_still = np.concatenate(still.models["box"])[-n:]
+    boxes_moved = np.concatenate(moved.models["box"])[-n:]
     assert np.allclose(boxes_moved, pose.bass_transform @ boxes_still)
     assert not np.allclose(boxes_moved, boxes_still, atol=1e-3)

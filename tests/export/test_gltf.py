@@ -189,3 +189,26 @@ def test_instrument_parts_move(demo_export: Export) -> None:
         "bass_instrument.translation",
     ):
         assert moving[key] > 1e-3, key
+
+
+def test_a_five_string_bass_exports_its_five_strings_all_vibrating(tmp_path: Path) -> None:
+    """The glTF draws the strings of the planned tuning (the low B too), each with a
+    vibration channel that moves, and no string the tuning lacks."""
+    from tests.conftest import DEMO_MID
+
+    config = tmp_path / "five.toml"
+    config.write_text('[plan]\nbass_tuning = "five"\n')
+    out = tmp_path / "five.glb"
+    export_performance(DEMO_MID, gltf=out, config=config, end_s=6.0)
+    doc = pygltflib.GLTF2().load(str(out))
+    names = {i: n.name for i, n in enumerate(doc.nodes)}
+    strings = sorted(n for n in names.values() if n and n.startswith("bass_string_"))
+    assert strings == sorted(f"bass_string_{s}" for s in "BEADG")
+    vibrating = {
+        names[ch.target.node]
+        for a in doc.animations
+        for ch in a.channels
+        if ch.target.path == "weights" and names[ch.target.node].startswith("bass_string_")
+    }
+    assert vibrating == set(strings)
+    assert not _errors(validate(out))

@@ -30,7 +30,7 @@ from virja.plan.config import PlanConfig, load_plan_config
 from virja.plan.types import PlannedNote
 from virja.routing import RoutingConfig
 from virja.session import run_schedule
-from virja.vocab import BASS_STRINGS, CYMBAL_PIECES
+from virja.vocab import CYMBAL_PIECES
 
 GLTF_SUFFIXES = (".glb", ".gltf")
 MAX_FPS = 240.0
@@ -125,7 +125,8 @@ def sample(
         kick_down=np.clip((up_y - toe) / max(up_y - down_y, 1e-6), 0.0, 1.0),
         hihat_down=np.clip((hh_up - ltoe) / max(hh_up - hh_dn, 1e-6), 0.0, 1.0),
         string_vibration={
-            s: np.array([p.string_vibration.get(s, 0.0) for p in poses]) for s in BASS_STRINGS
+            s: np.array([p.string_vibration.get(s, 0.0) for p in poses])
+            for s in animator.bass_strings  # the tuning's strings, drawn and vibrating
         },
         origin_s=origin_s,
         bass_transform=np.array([p.bass_transform for p in poses]),

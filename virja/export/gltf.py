@@ -18,7 +18,8 @@ Layout of the file (names are stable; tools may look them up):
   rises as the left foot lets the pedal up, the pedal boards ``kit_pedal_kick``
   and ``kit_pedal_hihat`` follow the feet;
 - the bass: ``bass_instrument`` (rotated and moved as it leans with its player,
-  about its endpin) and its strings ``bass_string_<E|A|D|G>``,
+  about its endpin) and the strings of the planned tuning ``bass_string_<B|E|A|D|G|C>``
+  (E A D G by default; five- and six-string tunings get theirs),
   whose one morph target (the fundamental mode) is weighted by the vibration;
 - one animation ``band`` (both figures, the kit, the strings), keyframed at
   the export rate, linear (one clip, so importers that play one animation at
@@ -82,7 +83,8 @@ class Sampled:
     - ``roots``: (2, 3) root (hips) positions of the two figures;
     - ``cymbal_swing``: piece -> (m,) radians; ``hihat_open``: (m,) 0..1;
     - ``kick_down``: (m,) 0 (pedal up) .. 1 (pressed), from the right foot;
-    - ``string_vibration``: string -> (m,) metres;
+    - ``string_vibration``: string -> (m,) metres, one per string of the tuning
+      (only those strings are drawn);
     - ``hihat_down``: (m,) 0 (pedal up) .. 1 (pressed), from the left foot (None:
       ``1 - hihat_open``);
     - ``origin_s``: the session time of the input's start (what users call 0).
@@ -674,7 +676,11 @@ def _upright_bass(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _
     b.segment("bass_endpin", node, bb.endpin, bb.endpin + 0.2 * up, 0.008, "chrome")
     lateral = np.cross(bb.axis, bb.front)
     lateral /= np.linalg.norm(lateral)
+    # the strings of the tuning the performance was planned on (string_vibration's keys)
+    tuning = [n for n in bb.strings if n in s.string_vibration] or list(BASS_STRINGS)
     for k, name in enumerate(bb.strings):
+        if name not in tuning:
+            continue
         a, z = bb.nut[name], bb.bridge[name]
         d = z - a
         rot_y = quat.from_two_vectors(Y, d)
@@ -692,7 +698,7 @@ def _upright_bass(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _
             mesh=b.string_mesh(f"string_{name}"),
         )
         amp = s.string_vibration.get(name)
-        if amp is not None and name in BASS_STRINGS:
+        if amp is not None:
             swing = np.cos(2 * np.pi * (9.0 + 1.3 * k) * s.times)
             # the target moves x by sin(pi y) mesh units; x is scaled by the radius
             anim.channel(node_s, "weights", amp * swing / radius)

@@ -14,37 +14,14 @@ The figures of docs/performance.md's GPU section come from this command.
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import shutil
 import sys
-import tempfile
-import time
-from pathlib import Path
 
 
 def _size(text: str) -> tuple[int, int]:
     w, _, h = text.partition("x")
     return int(w), int(h)
-
-
-def offline_factor(size: str, end: float | None) -> tuple[float, float, bool]:
-    """(music seconds / wall seconds, music seconds, with sound)."""
-    from virja.bench import demo_path, read_midi
-    from virja.cli.main import main
-
-    duration = read_midi(demo_path()).duration_s
-    stop = duration + 1.5 if end is None else min(end, duration + 1.5)
-    sound = shutil.which("fluidsynth") is not None
-    with tempfile.TemporaryDirectory(prefix="virja-gpu-bench-") as tmp:
-        argv = ["render", demo_path(), "--out", str(Path(tmp) / "demo.mp4")]
-        argv += ["--end", f"{stop}", "--size", size] + ([] if sound else ["--no-audio"])
-        start = time.perf_counter()
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            rc = main(argv)
-        wall = time.perf_counter() - start
-    return (stop / wall if rc == 0 else 0.0), stop, sound
 
 
 def main() -> int:
@@ -56,7 +33,7 @@ def main() -> int:
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
 
-    from virja.bench import gl_draw_ms, render_fps
+    from virja.bench import gl_draw_ms, offline_realtime_factor, render_fps
 
     out: dict[str, object] = {}
     for text in args.sizes:
@@ -73,7 +50,8 @@ def main() -> int:
                 flush=True,
             )
     for text in args.offline_sizes:
-        rtf, music, sound = offline_factor(text, args.end)
+        sound = shutil.which("fluidsynth") is not None
+        rtf, music = offline_realtime_factor(args.end, size=text, audio=sound)
         out[f"offline_{text}"] = {"realtime_factor": rtf, "music_s": music, "sound": sound}
         if not args.json:
             print(

@@ -331,10 +331,12 @@ def gl_draw_ms(frames: int = 90, size: tuple[int, int] = (1280, 720)) -> float:
     return float(np.median(times)) * 1000
 
 
-def offline_realtime_factor(seconds: float | None = None) -> tuple[float, float]:
+def offline_realtime_factor(
+    seconds: float | None = None, size: str = "1280x720", audio: bool = True
+) -> tuple[float, float]:
     """``virja render`` of the demo to an H.264 video with its sound, as a user runs it:
     (music seconds / wall seconds, music seconds).  ``seconds`` renders only the first
-    part of the demo."""
+    part of the demo; ``size`` the frame size; ``audio=False`` a silent video."""
     import contextlib
     import io
     import tempfile
@@ -345,6 +347,7 @@ def offline_realtime_factor(seconds: float | None = None) -> tuple[float, float]
     end = duration + 1.5 if seconds is None else min(seconds, duration + 1.5)
     with tempfile.TemporaryDirectory(prefix="virja-bench-") as tmp:
         argv = ["render", demo_path(), "--out", str(Path(tmp) / "demo.mp4"), "--end", f"{end}"]
+        argv += ["--size", size] + ([] if audio else ["--no-audio"])
         start = time.perf_counter()
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             rc = main(argv)

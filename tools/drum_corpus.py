@@ -19,10 +19,8 @@ from collections import Counter
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from virja.events import NoteOn
-from virja.midifile import read_midi
-from virja.plan import plan_notes_with_report
-from virja.routing import Router, route_all
+from virja.input import midi_input
+from virja.pipeline import PerformanceSettings, perform
 
 ALLOWED = {"too_many_hands"}
 
@@ -30,14 +28,14 @@ ALLOWED = {"too_many_hands"}
 def plan_file(
     path: str, lookahead: float = 1.0
 ) -> tuple[str, Counter[str], Counter[str], int, int]:
-    session = read_midi(path)
-    router = Router.for_session(session)
-    notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
-    planned, report = plan_notes_with_report(notes, session.tempo_map, lookahead_beats=lookahead)
-    drops = Counter(d.reason for d in report.dropped if d.performer == "drums")
+    # planned as `virja plan` and render plan it (virja.pipeline.perform)
+    settings = PerformanceSettings()
+    perf, planned = perform(settings, midi_input(Path(path), settings.routing, lookahead))
+    report = perf.planner.report
+    drops: Counter[str] = Counter(d.reason for d in report.dropped if d.performer == "drums")
     nobody = Counter(dict(report.unplayed))
     late = sum(1 for p in planned if p.performer == "drums" and p.late)
-    n = sum(1 for who, _ in notes if who == "drums")
+    n = perf.counts["notes_drums"]
     return path, drops, nobody, late, n
 
 

@@ -30,6 +30,7 @@ from virja.session import Performance, PlanSink
 
 if TYPE_CHECKING:
     from virja.input import PerformanceInput
+    from virja.plan.types import PlannedNote
 
 
 def _default_plan() -> PlanConfig:
@@ -102,3 +103,31 @@ def build_performance(
         # live, the first datagram's arrival (serve's Daemon.arrived) or the jam's start
         origin_s=src.start_s if src is not None else None,
     )
+
+
+def perform(
+    settings: PerformanceSettings,
+    src: PerformanceInput,
+    *,
+    animate: bool = False,
+    until_s: float | None = None,
+) -> tuple[Performance, list[PlannedNote]]:
+    """A whole input through :func:`build_performance` on a virtual clock, as fast as
+    possible (:func:`virja.session.run_schedule`): each event fed when it becomes known,
+    what has started committed, exactly as live.  ``until_s`` (seconds from the input's
+    start) leaves out the notes that sound after it (their note-offs and the beats stay).
+    Returns the performance (its planner's report, its animator) and every planned note
+    in commit order; ``plan``, ``motion-report`` and the capture tools plan here, so their
+    plans are the ones render draws."""
+    from virja.events import NoteOn
+    from virja.session import run_schedule
+
+    schedule = src.schedule
+    if until_s is not None:
+        end_s = src.start_s + until_s
+        schedule = [
+            r for r in schedule if not (isinstance(r.event, NoteOn) and r.event.time_s > end_s)
+        ]
+    perf = build_performance(settings, src, animate=animate)
+    perf.keep_planned = False
+    return perf, run_schedule(perf, schedule)

@@ -90,3 +90,19 @@ def test_pcap_recording_is_planned_from_capture_times(
         "left_hand", "right_hand", "left_hand", "right_hand",
     ]  # fmt: skip
     assert all(not p.late and abs(p.impact - p.time) < 1e-3 for p in notes)
+
+
+def test_plan_of_a_file_is_the_plan_render_draws(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`plan` goes through the same pipeline as render (virja.pipeline): the file's
+    beats reach the planner, so in 6/8 (beats of an eighth) the leads are render's too."""
+    take = Path(__file__).parents[1] / "data/gmd/drummer6_session1_3_rock_80_beat_6-8.mid"
+    assert main(["plan", str(take), "--json"]) == 0
+    planned = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    log = tmp_path / "render.jsonl"
+    argv = ["render", str(take), "--out", str(tmp_path / "f.png"), "--at", "0.5"]
+    assert main([*argv, "--size", "64x36", "--no-audio", "--plan-log", str(log)]) == 0
+    drawn = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(planned) == 147
+    assert [{k: d[k] for k in JSON_KEYS} for d in drawn] == planned

@@ -85,6 +85,25 @@ def test_write_then_read_back_keeps_sender_time_and_payload(tmp_path: Path) -> N
     assert cap.warnings == []
 
 
+@pytest.mark.parametrize(
+    ("bound", "dst"),
+    [
+        (("0.0.0.0", 50600), ("127.0.0.1", 50600)),
+        (("::", 50601, 0, 0), ("::1", 50601)),
+        (("192.0.2.7", 50602), ("192.0.2.7", 50602)),
+    ],
+)
+def test_a_listeners_recording_names_the_bound_port_and_a_real_address(
+    tmp_path: Path, bound: tuple[object, ...], dst: tuple[str, int]
+) -> None:
+    """serve --record: the packets are addressed to the port bound (port 0 picks one),
+    a wildcard address written as its family's loopback."""
+    p = tmp_path / "rec.pcap"
+    with PcapWriter.for_listener(p, bound) as w:
+        w.write(PAYLOAD, ("::1", 4321, 0, 0) if ":" in dst[0] else ("127.0.0.1", 4321), time_us=T)
+    assert read_capture(p, port=dst[1]).datagrams[0].dst == dst
+
+
 def test_writer_flushes_every_100_ms_of_given_time() -> None:
     buf = io.BytesIO()
 

@@ -29,7 +29,7 @@ from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from virja.cli.common import finite_float
+from virja.cli.common import add_routing_arguments, finite_float, performance_settings
 from virja.errors import ConfigError, InputFileError
 
 if TYPE_CHECKING:
@@ -39,7 +39,7 @@ if TYPE_CHECKING:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("input", help="MIDI file (type 0/1)")
+    parser.add_argument("input", help="MIDI file (type 0/1) or pcap recording of RMCP")
     parser.add_argument(
         "--lookahead-beats",
         type=finite_float,
@@ -59,20 +59,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--per-note", action="store_true", help="also print one line per note")
     parser.add_argument("--json", action="store_true", help="one JSON object with every figure")
-    parser.add_argument(
-        "--config", metavar="FILE.toml", help="configuration file ([plan]: the bass's tuning, ...)"
-    )
+    add_routing_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    from virja.events import NoteOn
-    from virja.midifile import read_midi
+    from virja.config import load_config
+    from virja.input import load_performance_input
     from virja.motion.band import BandAnimator
     from virja.motion.bassist_report import measure_bassist
     from virja.motion.drummer_report import measure_drummer
     from virja.motion.metrics import CONTACT_TOLERANCE_M, measure
-    from virja.plan import load_plan_config, plan_notes_with_report
-    from virja.routing import Router, route_all
+    from virja.pipeline import perform
 
     path = Path(args.input)
     if not 1 <= args.fps <= 1000:
@@ -81,30 +78,21 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--max-seconds must be > 0, got {args.max_seconds:g}")
     if not path.is_file():
         raise InputFileError(path, "no such file")
-    session = read_midi(path)
-    router = Router.for_session(session)
-    notes = [
-        (who, ev)
-        for who, ev in route_all(session.events, router)
-        if isinstance(ev, NoteOn) and ev.time_s <= args.max_seconds
-    ]
-    config = load_plan_config(args.config)
-    planned, report = plan_notes_with_report(
-        notes, session.tempo_map, lookahead_beats=args.lookahead_beats, config=config
-    )
+    # planned and animated as every command does (virja.pipeline): the file's notes,
+    # note-offs and beats, each revealed --lookahead-beats ahead
+    settings = performance_settings(args, load_config(args.config))
+    src = load_performance_input(path, settings.routing, lookahead_beats=args.lookahead_beats)
+    perf, planned = perform(settings, src, animate=True, until_s=args.max_seconds)
+    report = perf.planner.report
+    animator = perf.animator
+    assert isinstance(animator, BandAnimator)
+    config = settings.plan
     if not planned:
         print(
             f"{path}: no bass or drum notes in the first {args.max_seconds:g} s; nothing to measure"
         )
         return 0
     progress = Stage(len(planned), args.max_seconds)
-    animator = BandAnimator()
-    animator.use_bass_strings(tuple(name for name, _ in config.bass.strings))
-    animator.set_articulations({n: d.articulation for n, d in config.kit.notes.items()})
-    for beat in session.beats:
-        animator.add_beat(beat)
-    for p in planned:
-        animator.add_planned(p)
     progress("impact timing, contact and continuity")
     rep = measure(animator, planned, fps=args.fps)
     progress("the drummer's speeds, jumps, torso, collisions and hi-hat")

@@ -28,7 +28,6 @@ from virja.cli.common import (
     routing_config,
 )
 from virja.errors import ConfigError
-from virja.events import NoteOn
 from virja.input import PerformanceInput, nothing_for_the_band
 from virja.plan.types import PlannedNote, PlanReport
 from virja.vocab import PERFORMERS
@@ -52,36 +51,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_routing_arguments(parser)
 
 
-def _plan_midi(
-    path: Path, args: argparse.Namespace, doc: dict[str, Any]
-) -> tuple[list[PlannedNote], PlanReport]:
-    """A file's notes, each revealed --lookahead-beats ahead, planned as the daemon would
-    (:func:`virja.plan.plan_notes_with_report`: the notes alone, the file's tempo map)."""
-    from virja.midifile import read_midi
-    from virja.plan import plan_notes_with_report
-    from virja.routing import Router, route_all
-
-    session = read_midi(path)
-    settings = performance_settings(args, doc)
-    router = Router.for_session(session, settings.routing)
-    notes = [(who, ev) for who, ev in route_all(session.events, router) if isinstance(ev, NoteOn)]
-    return plan_notes_with_report(
-        notes,
-        session.tempo_map,
-        lookahead_beats=args.lookahead_beats,
-        config=settings.plan,
-    )
-
-
-def _plan_pcap(
+def _plan(
     src: PerformanceInput, args: argparse.Namespace, doc: dict[str, Any]
 ) -> tuple[list[PlannedNote], PlanReport]:
-    """A recording through the live receiver and planner on its recorded clock."""
-    from virja.pipeline import build_performance
-    from virja.session import run_schedule
+    """The input through the pipeline every command builds (:func:`virja.pipeline.perform`):
+    a MIDI file's events (notes, note-offs, its BEAT messages) each revealed
+    --lookahead-beats ahead, a recording's on its recorded clock, planned as the daemon would."""
+    from virja.pipeline import perform
 
-    perf = build_performance(performance_settings(args, doc), src)
-    return run_schedule(perf, src.schedule), perf.planner.report
+    perf, planned = perform(performance_settings(args, doc), src)
+    return planned, perf.planner.report
 
 
 def _input(path: Path, args: argparse.Namespace, doc: dict[str, Any]) -> PerformanceInput:
@@ -161,10 +140,7 @@ def run(args: argparse.Namespace) -> int:
         print(line, file=sys.stderr if args.json else sys.stdout)
     if src.note_count == 0:
         raise nothing_for_the_band(path, src.report)
-    if src.kind == "pcap":
-        planned, report = _plan_pcap(src, args, doc)
-    else:
-        planned, report = _plan_midi(path, args, doc)
+    planned, report = _plan(src, args, doc)
     if args.json:
         try:
             for p in planned:

@@ -355,10 +355,7 @@ async def serve(args: argparse.Namespace) -> int:
         daemon.viewer = viewer
         perf.plan_log = open_plan_log(args.plan_log)
         if args.record:
-            # the recording names the address and port actually bound (port 0 picks one)
-            wildcard = bound[0] in ("0.0.0.0", "::")
-            local_host = ("::1" if ":" in bound[0] else "127.0.0.1") if wildcard else bound[0]
-            recorder = PcapWriter.open(args.record, local=(local_host, bound[1]))
+            recorder = PcapWriter.for_listener(args.record, bound)
             protocol.recorder = daemon.recorder = recorder
             if rtp is not None:
                 rtp.recorder = recorder

@@ -1,7 +1,8 @@
 """Teaching data from our own band: the bassist's and drummer's motion with the session's audio.
 
 A MIDI session is planned and animated exactly as `virja render` does it
-(routing -> :func:`~virja.plan.planner.plan_notes` -> :class:`~virja.motion.band.BandAnimator`),
+(:func:`virja.pipeline.perform`: routing, the planner with the file's beats, a
+:class:`~virja.motion.band.BandAnimator`),
 both players are sampled at a fixed rate into BVH
 (:func:`~virja.motion.export.performance_to_bvh`: ``<stem>_drums.bvh``,
 ``<stem>_bass.bvh``), and the same file is rendered to a WAV by fluidsynth
@@ -27,13 +28,11 @@ import mido
 import numpy as np
 
 from virja.errors import InputFileError, NotAvailableError
-from virja.events import NoteOn
-from virja.midifile import read_midi
+from virja.input import midi_input
 from virja.motion.band import BandAnimator
 from virja.motion.export import performance_to_bvh
-from virja.plan.planner import plan_notes
+from virja.pipeline import PerformanceSettings, perform
 from virja.render.video import find_soundfont, render_audio
-from virja.routing import Router, route_all
 
 log = logging.getLogger(__name__)
 
@@ -55,21 +54,16 @@ class BandCapture:
 
 
 def animate_midi(midi_path: str | Path) -> tuple[BandAnimator, float]:
-    """Plan and animate a MIDI file's band notes; (animator, duration of the file in s)."""
-    session = read_midi(midi_path)
-    routed = [
-        (p, e)
-        for p, e in route_all(session.events, Router.for_session(session))
-        if isinstance(e, NoteOn)
-    ]
-    if not routed:
+    """Plan and animate a MIDI file's band notes as render does; (animator, duration of
+    the file in s)."""
+    settings = PerformanceSettings()
+    src = midi_input(Path(midi_path), settings.routing, lookahead_beats=1.0)
+    if src.note_count == 0:
         raise InputFileError(midi_path, "no notes for the band (bass or drums) in this file")
-    animator = BandAnimator()
-    for b in session.beats:
-        animator.add_beat(b)
-    for p in plan_notes(routed, session.tempo_map):
-        animator.add_planned(p)
-    return animator, session.duration_s
+    perf, _planned = perform(settings, src, animate=True)
+    assert isinstance(perf.animator, BandAnimator)
+    assert src.midi is not None
+    return perf.animator, src.midi.duration_s
 
 
 def capture_session(

@@ -22,7 +22,7 @@ import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from virja.errors import InputFileError
 from virja.rmcp import DEFAULT_PORT
@@ -113,6 +113,16 @@ class PcapWriter:
         except OSError as exc:
             stream.close()
             raise InputFileError(path, f"cannot write recording: {exc.strerror or exc}") from None
+
+    @classmethod
+    def for_listener(cls, path: str | Path, bound: tuple[Any, ...]) -> PcapWriter:
+        """A recording of what a socket bound to ``bound`` (its ``getsockname()``)
+        receives: the packets name the address and port actually bound (port 0 picks
+        one; a wildcard address is written as the loopback of its family)."""
+        host, port = str(bound[0]), int(bound[1])
+        if host in ("0.0.0.0", "::"):
+            host = "::1" if ":" in host else "127.0.0.1"
+        return cls.open(path, local=(host, port))
 
     def write(
         self,

@@ -136,3 +136,47 @@ def test_rmcp_stream_sends_datagrams_over_loopback_udp() -> None:
         stream.close()
         rx.close()
     assert wire.to_events(wire.Datagram.parse(data)) == [NoteOn(T, 9, 36, 100, 1)]
+
+
+def test_rmcp_stream_numbers_each_datagram_once_when_two_threads_send() -> None:
+    """jam --rtp-midi: the keyboard's MIDI thread and the RTP-MIDI listener's thread
+    both send; every datagram gets its own sequence number, sent in numbering order."""
+    import sys
+    import threading
+
+    class Wire:
+        def __init__(self) -> None:
+            self.sent: list[bytes] = []
+
+        def sendto(self, data: bytes, target: object) -> None:
+            self.sent.append(data)  # a list's append is atomic
+
+        def close(self) -> None:
+            pass
+
+    stream = RmcpStream("127.0.0.1", 9, seq_start=0)
+    stream._sock.close()
+    fake = Wire()
+    stream._sock = fake  # type: ignore[assignment]
+    n = 1500
+
+    def play(channel: int, performer: str) -> None:
+        for i in range(n):
+            stream.send_routed(Routed(performer, NoteOn(T + i, channel, 40, 90)))  # type: ignore[arg-type]
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # switch threads as often as possible: races show
+    try:
+        threads = [
+            threading.Thread(target=play, args=(0, "bass")),
+            threading.Thread(target=play, args=(9, "drums")),
+        ]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(timeout=30)
+    finally:
+        sys.setswitchinterval(interval)
+    seqs = [wire.Datagram.parse(d).seq for d in fake.sent]
+    assert len(seqs) == 2 * n and stream.sent == 2 * n
+    assert seqs == list(range(2 * n))  # unique, and on the wire in numbering order

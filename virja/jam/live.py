@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import queue
 import socket
+import threading
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -81,6 +82,7 @@ class KeyboardJam:
         self.thru = thru
         self.stream = stream
         self._queue: queue.Queue[Arrival] = queue.Queue(maxsize=max_queue)
+        self._dropped_lock = threading.Lock()  # handle() runs on the MIDI and RTP-MIDI threads
         self.dropped = 0
 
     def handle(self, data: bytes, arrival_s: float) -> None:
@@ -102,7 +104,8 @@ class KeyboardJam:
         try:
             self._queue.put_nowait(Arrival(arrival_s, routed))
         except queue.Full:
-            self.dropped += 1
+            with self._dropped_lock:
+                self.dropped += 1
             log.warning("jam queue full (the main loop is stalled); event dropped")
 
     def drain(self) -> list[Arrival]:
@@ -128,14 +131,16 @@ class RmcpStream:
     before it, so the receiver's router gives that channel to the bassist even
     if it joined late or lost a datagram; drums go on channel 10 and need
     nothing.  Sequence numbers start at ``seq_start`` (the CLI passes the clock
-    in milliseconds, so a restarted jam keeps numbering upwards).  Not
-    thread-safe beyond the GIL: one caller (the MIDI thread) sends.
+    in milliseconds, so a restarted jam keeps numbering upwards).  Thread-safe:
+    the keyboard's MIDI thread and the RTP-MIDI listener's thread both send, and
+    each datagram gets its own number, sent in numbering order.
     """
 
     def __init__(self, host: str, port: int, *, sender: int = 1, seq_start: int = 0) -> None:
         self.sender = sender
         self.addr = (host, port)
         self._seq = seq_start & 0xFFFF_FFFF
+        self._lock = threading.Lock()  # numbering and sending: one sender at a time
         self._bass_channels: set[int] = set()
         try:
             info = socket.getaddrinfo(host, port, type=socket.SOCK_DGRAM)[0]
@@ -167,12 +172,13 @@ class RmcpStream:
     def send_routed(self, routed: Routed) -> None:
         if routed.performer is None:
             return
-        for data in self.datagrams(routed):
-            try:
-                self._sock.sendto(data, self._target)
-                self.sent += 1
-            except OSError as exc:  # a remote that is not up must not stop the jam
-                log.warning("RMCP send to %s:%s failed: %s", *self.addr, exc)
+        with self._lock:
+            for data in self.datagrams(routed):
+                try:
+                    self._sock.sendto(data, self._target)
+                    self.sent += 1
+                except OSError as exc:  # a remote that is not up must not stop the jam
+                    log.warning("RMCP send to %s:%s failed: %s", *self.addr, exc)
 
     def close(self) -> None:
         self._sock.close()

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import mido
 import pytest
 
 from tests.conftest import DEMO_MID
@@ -29,6 +32,37 @@ def test_a_bass_named_track_is_the_bassists_whatever_its_program_and_the_report_
     assert r.route(NoteOn(0.1, 1, 60, 90, track=2)) is None  # a piano part stays the piano's
     (line,) = [x for x in r.report() if "'Bass'" in x]
     assert "bassist" in line and "GM program 26 is not a bass" in line
+
+
+def test_a_bass_named_track_on_another_instrument_is_left_when_the_file_has_its_bass(
+    tmp_path: Path,
+) -> None:
+    """An MMA session: 'Bass-Hits' horn stabs (GM 66, tenor sax) beside 'Bass' (GM 33):
+    the bassist plays 'Bass' only, and the report says why the other was left and
+    how to add it; alone, the same track would still be the bass part."""
+    mf = mido.MidiFile(type=1)
+    for name, channel, program, note in (("Bass-Hits2", 11, 65, 50), ("Bass", 15, 32, 40)):
+        tr = mido.MidiTrack()
+        mf.tracks.append(tr)
+        tr.append(mido.MetaMessage("track_name", name=name))
+        tr.append(mido.Message("program_change", program=program, channel=channel))
+        for _ in range(4):
+            tr.append(mido.Message("note_on", note=note, velocity=90, channel=channel))
+            tr.append(mido.Message("note_off", note=note, velocity=0, channel=channel, time=240))
+    both = tmp_path / "mma.mid"
+    mf.save(both)
+    session = read_midi(both)
+    r = Router.for_session(session)
+    routed = route_all(session.events, r)
+    assert {ev.note for who, ev in routed if who == "bass"} == {40}
+    (line,) = [x for x in r.report() if "'Bass-Hits2'" in x]
+    assert "not the band's" in line and "GM program 66 is not a bass" in line
+    assert "track 1 'Bass' plays one" in line and "--bass-track 'Bass-Hits2'" in line
+    del mf.tracks[1]
+    alone = tmp_path / "alone.mid"
+    mf.save(alone)
+    session = read_midi(alone)
+    assert {who for who, _ in route_all(session.events, Router.for_session(session))} == {"bass"}
 
 
 def test_configuration_lets_the_program_win_over_the_name() -> None:

@@ -9,7 +9,11 @@ Rules, in order (the first that decides wins), all data in
 3. a drum channel (default MIDI channel 10, index 9) -> drums;
 4. the track's name reads as a bass part (``bass_track_words``) -> bass, whatever
    its program ("Bass" with GM program 26 is still the bass part; :meth:`Router.report`
-   says so); ``names_over_programs = false`` turns this rule off;
+   says so), unless another track of the file plays a GM bass program: then that
+   track is the bass part and a bass-named track on another instrument is not (an
+   MMA session's "Bass-Hits" horn stabs on program 66 beside its "Bass" on 32; the
+   report says so and names the flag that adds it); ``names_over_programs = false``
+   turns this rule off;
 5. the GM program in force on the channel is a bass (32-39) -> bass; any other
    program -> nobody (a piano part never makes the bassist play chords);
 6. otherwise nobody.
@@ -159,20 +163,40 @@ class Router:
     max_programs = MAX_PROGRAMS
 
     def __init__(
-        self, config: RoutingConfig | None = None, track_names: Mapping[int, str] | None = None
+        self,
+        config: RoutingConfig | None = None,
+        track_names: Mapping[int, str] | None = None,
+        bass_program_tracks: Iterable[int] = (),
     ) -> None:
         self.config = config or RoutingConfig()
         self.track_names = dict(track_names or {})
+        # tracks of the file that play a GM bass program somewhere: the bass part, so
+        # a bass-named track on another instrument is not (rule 4)
+        self.bass_program_tracks = frozenset(bass_program_tracks)
         self._programs: OrderedDict[tuple[int | None, int], int] = OrderedDict()
         self.programs_evicted = 0
         self.counts: Counter[tuple[int | None, int, str]] = Counter()
         # (track, channel) -> the non-bass program a bass-named track was played over
         self.named_over_program: dict[tuple[int | None, int], int] = {}
+        # (track, channel) -> (its non-bass program, the track with a bass program) for a
+        # bass-named track left to nobody because the file has a real bass part
+        self.named_but_left: dict[tuple[int | None, int], tuple[int, int]] = {}
 
     @classmethod
     def for_session(cls, session: Any, config: RoutingConfig | None = None) -> Router:
-        """A router for a :class:`virja.midifile.MidiSession` (knows its track names)."""
-        return cls(config, {t.index: t.name for t in session.tracks})
+        """A router for a :class:`virja.midifile.MidiSession` (knows its track names,
+        and which tracks play a bass program)."""
+        cfg = config or RoutingConfig()
+        bass_tracks = {
+            ev.track
+            for ev in session.events
+            if isinstance(ev, ProgramChange)
+            and ev.track is not None
+            and ev.program in cfg.bass_programs
+            and (cfg.channels.get(ev.channel + 1, "bass") == "bass")
+            and ev.channel + 1 not in cfg.drum_channels
+        }
+        return cls(config, {t.index: t.name for t in session.tracks}, bass_tracks)
 
     def _source(self, event: Event) -> int | None:
         track = getattr(event, "track", None)
@@ -214,6 +238,10 @@ class Router:
         )
         if named_bass and (cfg.names_over_programs or program is None):
             if program is not None and program not in cfg.bass_programs:
+                others = sorted(self.bass_program_tracks - {track})
+                if others:  # the file has its bass part: this is another instrument
+                    self.named_but_left[(track, event.channel)] = (program, others[0])
+                    return None
                 self.named_over_program[(track, event.channel)] = program
             return "bass"
         if program is not None:
@@ -236,6 +264,14 @@ class Router:
                 who += (
                     f" (named as a bass part; its GM program {program + 1} is not a bass;"
                     " [routing] names_over_programs = false to leave it)"
+                )
+            left = self.named_but_left.get((track, channel))
+            if route == "none" and left is not None and track is not None:
+                other = self.track_names.get(left[1], "")
+                who += (
+                    f" (named like a bass part, but its GM program {left[0] + 1} is not a bass"
+                    f" and track {left[1]}" + (f" {other!r}" if other else "") + " plays one;"
+                    f" --bass-track {self.track_names.get(track, '')!r} adds it)"
                 )
             lines.append(f"{where}: {n} note{'' if n == 1 else 's'} -> {who}")
         return lines

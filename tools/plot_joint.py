@@ -27,17 +27,24 @@ from virja.plan import plan_notes
 from virja.tempo import ConstantTempo
 
 
-def _planned(midi: Path | None) -> list:
+def _animated(midi: Path | None) -> tuple[BandAnimator, list]:
+    """The band animated: the paper's experiment, or a MIDI file played as render plays
+    it (virja.pipeline.perform: routing, the planner with the file's beats)."""
     if midi is None:
         notes = [("drums", NoteOn(1.0 + 0.125 * i, 9, 38, 100)) for i in range(4)]
         notes += [("drums", NoteOn(1.0 + 0.25 * i, 9, 51, 90)) for i in range(2)]
-        return plan_notes(notes, ConstantTempo(0.5))  # type: ignore[arg-type]
-    from virja.midifile import read_midi
-    from virja.routing import Router, route_all
+        planned = plan_notes(notes, ConstantTempo(0.5))  # type: ignore[arg-type]
+        a = BandAnimator()
+        for p in planned:
+            a.add_planned(p)
+        return a, planned
+    from virja.input import midi_input
+    from virja.pipeline import PerformanceSettings, perform
 
-    s = read_midi(midi)
-    notes = [(w, e) for w, e in route_all(s.events, Router.for_session(s)) if isinstance(e, NoteOn)]
-    return plan_notes(notes, s.tempo_map)  # type: ignore[arg-type]
+    settings = PerformanceSettings()
+    perf, planned = perform(settings, midi_input(midi, settings.routing, 1.0), animate=True)
+    assert isinstance(perf.animator, BandAnimator)
+    return perf.animator, planned
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -61,13 +68,10 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError:
         print("plot_joint: matplotlib is not installed; pip install 'virja[plot]'", file=sys.stderr)
         return 2
-    planned = _planned(args.midi)
+    a, planned = _animated(args.midi)
     if not planned:
         print("plot_joint: no bass or drum notes to animate", file=sys.stderr)
         return 1
-    a = BandAnimator()
-    for p in planned:
-        a.add_planned(p)
     t0 = min(p.start for p in planned) - 0.2
     t1 = max(p.impact for p in planned) + 0.6
     times = t0 + np.arange(int((t1 - t0) * args.fps) + 1) / args.fps

@@ -121,8 +121,7 @@ def _frames(
     """(k, n, 3) bassist joint positions, (k, n, 4) rotations, (k, m, 3) finger points (world),
     and (k, n, 3) the joint positions in the bass's own frame (it leans with him)."""
     pos, rot, fingers, own = [], [], [], []
-    for t in times:
-        pose = animator.pose(float(t))
+    for pose in animator.poses(np.asarray(times, dtype=np.float64)):  # batched over times
         pos.append(pose.bass.positions)
         rot.append(pose.bass.rotations)
         fingers.append(pose.bass_fingers.reshape(-1, 3))

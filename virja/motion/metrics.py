@@ -83,37 +83,46 @@ def contact_distance(
     animator: BandAnimator, p: PlannedNoteLike, t: float
 ) -> tuple[float, float | None]:
     """(contact distance, fretting distance or None) of note ``p`` at time ``t`` (m)."""
+    contact, fret = contact_distances(animator, p, np.array([t]))
+    return float(contact[0]), None if fret is None else float(fret[0])
+
+
+def contact_distances(
+    animator: BandAnimator, p: PlannedNoteLike, times: np.ndarray
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`contact_distance` at many times (sorted ascending), the poses batched:
+    (contact distances (m,), fretting distances (m,) or None)."""
     geo: Geometry = animator.geometry
-    loc = animator.local_rotations(t)
-    wpos, wrot = _SK.fk(loc, animator._roots)
+    loc = animator.local_rotations_many(np.asarray(times, dtype=np.float64))
+    wpos, wrot = _SK.fk(loc, animator._roots)  # (m, 2, n, 3), (m, 2, n, 4)
     if p.performer == "drums":
         clip = p.motion.clip if isinstance(p.motion, DrumStroke) else p.motion.name
         piece = p.piece or animator.library[clip].piece or ""
         if p.limb in HANDS:
-            tip = sticks(wpos[0], wrot[0])[0 if p.limb == "left_hand" else 1, 1]
-            return geo.kit.surface_distance(piece, tip), None
+            tips = sticks(wpos[:, 0], wrot[:, 0])[:, 0 if p.limb == "left_hand" else 1, 1]
+            return np.array([geo.kit.surface_distance(piece, tip) for tip in tips]), None
         pedal = geo.kit.kick_pedal if piece == "kick" else geo.kit.hihat_pedal
-        toe = wpos[0, _SK.index("RightToe" if p.limb == "right_foot" else "LeftToe")]
-        return float(np.linalg.norm(toe - pedal.toe_point(True))), None
+        toe = wpos[:, 0, _SK.index("RightToe" if p.limb == "right_foot" else "LeftToe")]
+        return np.linalg.norm(toe - pedal.toe_point(True), axis=-1), None
     assert p.string is not None
     # the bass leans with its player (BandPose.bass_transform): the targets lean with it
-    lean = animator.bass_transform(wpos[1])
-    pluck = float(
-        np.linalg.norm(
-            wpos[1, _SK.index("RightHandEnd")]
-            - bass_lean.apply(lean, geo.bass.pluck_point(p.string))
-        )
-    )
+    leans = animator.bass_transform(wpos[:, 1])  # (m, 4, 4)
+    pluck_at = np.stack([bass_lean.apply(m, geo.bass.pluck_point(p.string)) for m in leans])
+    pluck = np.linalg.norm(wpos[:, 1, _SK.index("RightHandEnd")] - pluck_at, axis=-1)
     fret = None
     if p.fret:
-        stop = bass_lean.apply(lean, geo.bass.string_point(p.string, p.fret))
-        fret = float(np.linalg.norm(wpos[1, _SK.index("LeftHandEnd")] - stop))
+        stop = np.stack(
+            [bass_lean.apply(m, geo.bass.string_point(p.string, p.fret)) for m in leans]
+        )
+        fret = np.linalg.norm(wpos[:, 1, _SK.index("LeftHandEnd")] - stop, axis=-1)
     return pluck, fret
 
 
 def _timing(animator: BandAnimator, p: PlannedNoteLike) -> float:
+    """When the tip is really closest to its target, minus the planned impact (s):
+    searched over +-60 ms in 1 ms steps."""
     ts = p.impact + np.arange(-60, 61) * 1e-3
-    d = np.array([contact_distance(animator, p, float(t))[0] for t in ts])
+    d = contact_distances(animator, p, ts)[0]
     return float(ts[int(np.argmin(d))] - p.impact)
 
 
@@ -137,7 +146,7 @@ def continuity(
     times = t0 + np.arange(int((t1 - t0) * fps) + 1) / fps
     if len(times) < 3:
         return 0.0, 0.0, len(times)
-    loc = np.stack([animator.local_rotations(float(t)) for t in times])  # (k, 2, n, 4)
+    loc = animator.local_rotations_many(times)  # (k, 2, n, 4)
     limb_idx = sorted(
         {_SK.index(j) for f in FIGURES for limb in PERFORMER_LIMBS[f] for j in LIMB_JOINTS[limb]}
     )

@@ -13,7 +13,7 @@ import pytest
 
 from virja.input import load_performance_input
 from virja.motion.band import BandAnimator
-from virja.pipeline import PerformanceSettings, build_performance
+from virja.pipeline import PerformanceSettings, build_performance, perform
 from virja.plan.config import load_plan_config
 from virja.plan.immediate import immediate_strokes
 from virja.plan.planner import plan_notes
@@ -55,6 +55,22 @@ def test_a_file_plays_every_note_the_offline_planner_plays() -> None:
     offline = plan_notes(notes, session.tempo_map)  # type: ignore[arg-type]
     key = lambda p: (p.time, p.performer, p.note)  # noqa: E731
     assert sorted(map(key, planned)) == sorted(map(key, offline))
+
+
+def test_perform_plays_a_whole_input_and_until_leaves_out_the_later_notes() -> None:
+    """`plan`, `motion-report` and the capture tools plan here: the notes render plans,
+    an animator that has them all, and with ``until_s`` only the notes up to it."""
+    settings = PerformanceSettings()
+    src = load_performance_input(DEMO, settings.routing)
+    perf, planned = perform(settings, src, animate=True)
+    assert isinstance(perf.animator, BandAnimator)
+    expected = run_schedule(build_performance(settings, src), src.schedule)
+    assert planned == expected and len(planned) == 219
+    assert perf.planned == []  # the caller has them; the performance keeps none twice
+    _perf, first = perform(settings, src, until_s=4.0)
+    assert first and max(p.time for p in first) <= 4.0
+    # the same notes (their motions may differ where a later note would have changed them)
+    assert [(p.time, p.note) for p in first] == [(p.time, p.note) for p in planned if p.time <= 4.0]
 
 
 def test_immediate_notes_get_the_shortest_strokes_and_an_animator_when_asked() -> None:

@@ -32,6 +32,7 @@ from virja.motion.drummer_hands import DrummerHands, HandSettings
 from virja.motion.drummer_kit import HihatState, default_articulations
 from virja.motion.hits import Hit, HitTable
 from virja.motion.pose import BandPose, FigurePose
+from virja.motion.pose_batch import BandPoses
 from virja.motion.skeleton import (
     LIMB_JOINTS,
     SKELETON,
@@ -462,34 +463,66 @@ class BandAnimator:
 
         ``local`` is :meth:`local_rotations_many` of ``times`` if the caller has it.
         """
-        ts = np.asarray(times, dtype=np.float64)
+        return self.pose_batch(times, local).all()
+
+    def pose_batch(self, times: np.ndarray, local: np.ndarray | None = None) -> BandPoses:
+        """The band at many times (sorted ascending) as arrays, one row a frame: what
+        the render loops draw (:func:`virja.render.scene_batch.band_scenes`).
+
+        Everything is computed for all the frames at once (the kit and string state
+        from :class:`HitTable`'s windows, FK, sticks, the bass's lean) except the
+        hi-hat's notes, the stopped frets and the bassist's fingers, which are a few
+        Python look-ups or his own per-frame method.  Equal to :meth:`pose` frame by
+        frame to rounding (tests/motion/test_band_batch.py).
+        """
+        ts = np.asarray(times, dtype=np.float64).reshape(-1)
         loc = self.local_rotations_many(ts) if local is None else local
         wpos, wrot = _SK.fk(loc, self._roots)
-        all_sticks = sticks(wpos[:, 0], wrot[:, 0])
         leans = self.bass_transform(wpos[:, 1])  # (m, 4, 4), one pass
-        out = []
-        for k, t in enumerate(ts.tolist()):
-            p, r = wpos[k], wrot[k]
-            lean, fingers = self._bass_parts(t, p[1], leans[k])
-            figs = [FigurePose(_SK.names, _SK.parents, p[i], r[i], _SK.radii) for i in range(2)]
-            out.append(
-                BandPose(
-                    time_s=t,
-                    drums=figs[0],
-                    bass=figs[1],
-                    sticks=all_sticks[k],
-                    hihat_open=self._hihat_open(p[0], t),
-                    cymbal_swing=self._swings(t),
-                    head_hits=self._head_hits(t),
-                    string_vibration=self._strings(t),
-                    string_stops=self._stops(t),
-                    fretting_tip=p[1, _SK.index("LeftHandEnd")].copy(),
-                    plucking_tip=p[1, _SK.index("RightHandEnd")].copy(),
-                    bass_fingers=fingers,
-                    bass_transform=lean,
-                )
-            )
-        return out
+        s = self.settings
+        tl = ts.tolist()
+        by_foot = np.clip(
+            (wpos[:, 0, self._ltoe, 1] - self._hihat_pressed_y) / s.hihat_travel_m, 0.0, 1.0
+        )
+        hihat = by_foot.copy()
+        for k, t in enumerate(tl):
+            by_notes = self.hihat.openness(t)
+            if by_notes is not None:
+                foot = float(by_foot[k])
+                hihat[k] = by_notes + self.hihat.chick_weight(t) * max(foot - by_notes, 0.0)
+        strings = self.bass_strings
+        stops = np.array(
+            [[d[n] for n in strings] for d in map(self._stops, tl)], dtype=np.int64
+        ).reshape(ts.size, len(strings))
+        # the fingers are laid out in the bass's own frame, then leaned with it
+        rot, shift = leans[:, :3, :3], leans[:, :3, 3]
+        own = (wpos[:, 1] - shift[:, None, :]) @ rot
+        fingers = np.array([self.bassist.fingers(t, own[k]) for k, t in enumerate(tl)])
+        fingers = (
+            fingers.reshape(ts.size, -1, 2, 3) if fingers.size else np.zeros((ts.size, 0, 2, 3))
+        )
+        fingers = np.einsum("mkpj,mij->mkpi", fingers, rot) + shift[:, None, None, :]
+        return BandPoses(
+            times=ts,
+            names=_SK.names,
+            parents=_SK.parents,
+            radii=_SK.radii,
+            positions=wpos,
+            rotations=wrot,
+            sticks=sticks(wpos[:, 0], wrot[:, 0]),
+            hihat_open=hihat,
+            cymbals=tuple(sw[0] for sw in s.swing),
+            cymbal_swing=self._hits.swings_many(ts, s.swing),
+            drums=tuple(DRUM_PIECES),
+            head_hits=self._hits.head_hits_many(ts, DRUM_PIECES, s.head_decay_s),
+            strings=strings,
+            string_vibration=self._hits.strings_many(ts, strings, s.string_amp_m, s.string_decay_s),
+            string_stops=stops,
+            fretting_tip=wpos[:, 1, _SK.index("LeftHandEnd")],
+            plucking_tip=wpos[:, 1, _SK.index("RightHandEnd")],
+            bass_fingers=fingers,
+            bass_transform=leans,
+        )
 
     def bass_transform(self, bass_wpos: np.ndarray) -> np.ndarray:
         """(..., 4, 4) the bass's world transform for the bassist's joint positions

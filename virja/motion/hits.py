@@ -111,5 +111,78 @@ class HitTable:
                 out[name] = 0.0
         return out
 
+    # -- many times at once (the render loops ask for chunks of frames) --------------
+
+    def _windows(
+        self, name: str, ts: np.ndarray, span: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """``name``'s impacts in [t - span, t] for each of ``ts`` (m,), padded to the widest
+        window: (times (m, w), velocities (m, w), valid (m, w)), each row in time order;
+        None when ``name`` has no impact at all."""
+        self._window(name, 0.0, 0.0)  # builds the per-name arrays
+        assert self._by_name is not None
+        found = self._by_name.get(name)
+        if found is None:
+            return None
+        _keys, time_arr, vel_arr = found
+        lo = np.searchsorted(time_arr, ts - span, side="left")
+        hi = np.searchsorted(time_arr, ts, side="right")
+        w = int(np.max(hi - lo, initial=0))
+        idx = lo[:, None] + np.arange(max(w, 1))[None, :]
+        valid = idx < hi[:, None]
+        idx = np.minimum(idx, time_arr.size - 1)
+        return time_arr[idx], vel_arr[idx], valid
+
+    def swings_many(
+        self, ts: np.ndarray, swing: Iterable[tuple[str, float, float, float]]
+    ) -> np.ndarray:
+        """:meth:`swings` at each of ``ts`` (m,): (m, cymbals) in ``swing``'s order.  The
+        terms are added in time order, one window position at a time, as ``swings`` adds
+        them."""
+        spec = list(swing)
+        out = np.zeros((ts.size, len(spec)))
+        for j, (piece, amp, tau, freq) in enumerate(spec):
+            win = self._windows(piece, ts, 8.0)
+            if win is None:
+                continue
+            times, vels, valid = win
+            dt = ts[:, None] - times
+            terms = amp * vels / 127 * np.exp(-dt / tau) * np.sin(2 * np.pi * freq * dt)
+            out[:, j] = np.where(valid, terms, 0.0).sum(axis=1)
+        return out
+
+    def head_hits_many(self, ts: np.ndarray, pieces: Iterable[str], tau: float) -> np.ndarray:
+        """:meth:`head_hits` at each of ``ts`` (m,): (m, pieces) in ``pieces``' order."""
+        names = list(pieces)
+        out = np.zeros((ts.size, len(names)))
+        for j, piece in enumerate(names):
+            win = self._windows(piece, ts, 8 * tau)
+            if win is None:
+                continue
+            times, vels, valid = win
+            lit = np.where(valid, vels / 127 * np.exp(-(ts[:, None] - times) / tau), -np.inf)
+            out[:, j] = np.maximum(lit.max(axis=1), 0.0)
+        return out
+
+    def strings_many(
+        self, ts: np.ndarray, strings: Iterable[str], amp_m: float, decay_s: float
+    ) -> np.ndarray:
+        """:meth:`strings` at each of ``ts`` (m,): (m, strings) in ``strings``' order."""
+        names = list(strings)
+        out = np.zeros((ts.size, len(names)))
+        self._window("", 0.0, 0.0)  # builds the per-name arrays
+        assert self._by_name is not None
+        for j, name in enumerate(names):
+            found = self._by_name.get(name)
+            if found is None:
+                continue
+            _keys, time_arr, vel_arr = found
+            lo = np.searchsorted(time_arr, ts - 8 * decay_s, side="left")
+            hi = np.searchsorted(time_arr, ts, side="right")
+            last = np.maximum(hi - 1, 0)
+            value = amp_m * vel_arr[last] / 127 * np.exp(-(ts - time_arr[last]) / decay_s)
+            out[:, j] = np.where(hi > lo, value, 0.0)
+        return out
+
 
 _EMPTY = np.zeros(0)

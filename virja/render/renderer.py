@@ -40,10 +40,20 @@ class DrawList:
     models: dict[str, list[F64]] = field(default_factory=dict)
     colors: dict[str, list[F64]] = field(default_factory=dict)
     _frozen: dict[str, NDArray[np.float32]] | None = None
+    _rows: dict[str, NDArray[np.float32]] | None = None  # packed already (prepacked)
+
+    @classmethod
+    def prepacked(cls, rows: dict[str, NDArray[np.float32]]) -> DrawList:
+        """A frame's instances already packed as (n, 20) float32 rows per kind (a slice
+        of a chunk's table, :func:`virja.render.scene_batch.band_scenes`); unlike a
+        frozen list it is not cached as a static layer."""
+        return cls(_rows=rows)
 
     def add(self, kind: str, models: ArrayLike, color: ArrayLike) -> None:
         if self._frozen is not None:
             raise RuntimeError("this DrawList is frozen")
+        if self._rows is not None:
+            raise RuntimeError("this DrawList is prepacked")
         if kind not in MESHES:
             raise ValueError(f"unknown mesh kind {kind!r}; known: {sorted(MESHES)}")
         m = np.asarray(models, dtype=np.float64).reshape(-1, 4, 4)
@@ -58,6 +68,8 @@ class DrawList:
         """(n, 20) float32 instance rows of ``kind``; cached once :meth:`freeze` is called."""
         if self._frozen is not None:
             return self._frozen.get(kind, _EMPTY)
+        if self._rows is not None:
+            return self._rows.get(kind, _EMPTY)
         if kind not in self.models:
             return _EMPTY
         return pack_instances(np.concatenate(self.models[kind]), np.concatenate(self.colors[kind]))
@@ -72,6 +84,8 @@ class DrawList:
         return self
 
     def count(self) -> int:
+        if self._rows is not None:
+            return sum(len(r) for r in self._rows.values())
         return sum(sum(len(m) for m in ms) for ms in self.models.values())
 
 

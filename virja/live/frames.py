@@ -20,6 +20,7 @@ from virja.motion.pose import BandPose
 
 KEEP_MOTION_S = 20.0  # motions older than this are forgotten (memory stays flat)
 FORGET_EVERY = 60  # frames between forgets
+AHEAD_FRAMES = 6  # the band is posed for this many slots at once (thrown away on news)
 
 
 class FrameSink(Protocol):
@@ -83,11 +84,20 @@ class FrameLoop:
         self.stopped = False
         self.received = 0
         self.hud = HudTimeline()  # beats and chords: the heads-up display's line
+        # a BandAnimator's poses and scenes, a few slots at a time (render.chunks)
+        self.chunks: Any = None
+        if hasattr(animator, "pose_batch"):
+            from virja.render.chunks import FrameChunks
+
+            self.chunks = FrameChunks(animator)  # type: ignore[arg-type]
 
     def drain(self) -> None:
-        """Everything the planning side sent so far, into the animator."""
+        """Everything the planning side sent so far, into the animator (the frames
+        posed ahead are thrown away when it is told anything)."""
         while (item := self.inbox.get()) is not None:
             kind = item[0]
+            if self.chunks is not None and kind not in ("chord", "clock", "stop"):
+                self.chunks.invalidate()
             if kind == "planned":
                 self.animator.add_planned(item[1])
                 self.received += 1
@@ -123,17 +133,41 @@ class FrameLoop:
         if self.done:
             return False
         started = self.monotonic()
-        pose = self.animator.pose(self.anchor_s + slot.show_at)
+        pose, scene = self._pose(slot.show_at)
         hud_text = self.hud.at(self.anchor_s + slot.show_at).text()
         for s in self.sinks:
             set_hud = getattr(s, "set_hud", None)
             if set_hud is not None:
                 set_hud(hud_text)
-            s.show(pose)
+            show_frame = getattr(s, "show_frame", None)
+            if scene is not None and show_frame is not None:
+                show_frame(pose, scene)  # the window: the instances built with the chunk
+            else:
+                s.show(pose)
         self.pacer.drawn(started, self.monotonic())
         if self.pacer.shown % FORGET_EVERY == 0:
             self.animator.forget_before(self.anchor_s + started - KEEP_MOTION_S)
+            if self.chunks is not None:
+                self.chunks.invalidate()
         return True
+
+    def _pose(self, show_at: float) -> tuple[BandPose, Any]:
+        """The pose (and, for a BandAnimator, its instances) of the slot shown at
+        ``show_at``: from the frames posed ahead when it is one of them, else posed
+        with the next slots as the pacer will ask for them (without vsync the slots
+        are a period apart; with it, the swap decides: one frame at a time)."""
+        t = self.anchor_s + show_at
+        if self.chunks is None:
+            return self.animator.pose(t), None
+        if not self.chunks.has(t):
+            times = [t]
+            shows = show_at
+            for _ in range(0 if self.pacer.vsync else AHEAD_FRAMES - 1):
+                shows += self.pacer.period_s  # as FramePacer adds it, slot after slot
+                times.append(self.anchor_s + shows)
+            self.chunks.prepare(times)
+        frame: tuple[BandPose, Any] = self.chunks.frame(t)
+        return frame
 
     def run(self) -> None:
         while self.step():

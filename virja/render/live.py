@@ -82,12 +82,17 @@ class LiveView:
 
     def show(self, pose: BandPose, extra: Sequence[DrawList] = ()) -> None:
         """Draw ``pose`` (and ``extra`` layers) offscreen, copy it to the window, swap."""
+        self.show_frame(pose, band_scene(pose), extra)
+
+    def show_frame(self, pose: BandPose, scene: DrawList, extra: Sequence[DrawList] = ()) -> None:
+        """:meth:`show` with the pose's instances already built (``scene``: the frame
+        loop's chunk, :class:`virja.render.chunks.FrameChunks`)."""
         fb = self.host.framebuffer()
         if self.target is None or self.target.size != fb.size:
             if self.target is not None:
                 self.target.release()
             self.target = OffscreenTarget(self.host.ctx, fb.size, samples=self.samples)
-        layers = [self.static, band_scene(pose), *extra]
+        layers = [self.static, scene, *extra]
         self.renderer.draw(layers, self.host.state.camera, self.target.fbo)
         if self.host.state.hud and self.hud_text:
             if self._overlay is None:

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from virja.errors import ConfigError
 from virja.render.camera import PRESETS, Camera
+from virja.render.chunks import FrameChunks
 from virja.render.glflush import flush
 from virja.render.hosts import OffscreenTarget, create_headless_context
 from virja.render.hud import HudOverlay
@@ -210,14 +211,129 @@ def render_offline(
     t0_s, t1_s = span
     times = list(frame_times(t0_s, t1_s, settings.fps))
     static = static_scene()
+    animator = perf.animator
+    ahead = _Ahead(perf, feeder, times, CHUNK_FRAMES) if hasattr(animator, "pose_batch") else None
 
     def scene_at(t: float) -> list[DrawList]:
-        feeder.until(perf, t)
-        perf.advance(t)
-        layers = [static, band_scene(perf.pose(t))]
+        if ahead is not None:
+            band = ahead.scene(t)
+        else:
+            feeder.until(perf, t)
+            perf.advance(t)
+            band = band_scene(perf.pose(t))
+        layers = [static, band]
         return layers if extra is None else layers + extra(t)
 
-    seconds, outputs = render_frames(times, scene_at, settings, hud=lambda t: perf.hud.at(t).text())
+    try:
+        seconds, outputs = render_frames(
+            times, scene_at, settings, hud=lambda t: perf.hud.at(t).text()
+        )
+    finally:
+        if ahead is not None:
+            ahead.close()
+    if ahead is not None:
+        log.debug(
+            "%d frames posed in %d chunks (%.1f frames a chunk)",
+            ahead.chunks.frames,
+            ahead.chunks.chunks,
+            ahead.chunks.frames / max(ahead.chunks.chunks, 1),
+        )
     feeder.until(perf, math.inf)
     perf.finish()
     return RenderResult(len(times), seconds, t0_s, outputs)
+
+
+CHUNK_FRAMES = 30  # the offline render runs the timer (and poses) up to this many frames ahead
+
+_Call = tuple[str, tuple[object, ...]]
+
+
+class _Deferred:
+    """Stands in for the animator while the timer runs ahead of the frame drawn: keeps
+    what the performance tells it (``take`` hands it over frame by frame)."""
+
+    def __init__(self) -> None:
+        self.calls: list[_Call] = []
+
+    def take(self) -> list[_Call]:
+        calls, self.calls = self.calls, []
+        return calls
+
+    def add_planned(self, p: object) -> None:
+        self.calls.append(("add_planned", (p,)))
+
+    def add_beat(self, beat: object) -> None:
+        self.calls.append(("add_beat", (beat,)))
+
+    def note_off(self, performer: object, event: object) -> None:
+        self.calls.append(("note_off", (performer, event)))
+
+    def set_articulations(self, articulations: object) -> None:
+        self.calls.append(("set_articulations", (articulations,)))
+
+    def use_bass_strings(self, strings: object) -> None:
+        self.calls.append(("use_bass_strings", (strings,)))
+
+
+class _Ahead:
+    """The offline timer run up to :data:`CHUNK_FRAMES` frames ahead of the frame drawn,
+    so that the band is posed a chunk of frames at a time (:class:`FrameChunks`).
+
+    The events are fed and the motions committed at each frame's time exactly as
+    frame by frame (the planner sees the same calls in the same order), but what
+    the animator is told at frame ``j`` is held back until frame ``j`` is drawn: a
+    frame shows the animator as it was at its own time, and a chunk runs from
+    one frame with news for the animator to the next.
+    """
+
+    def __init__(
+        self, perf: Performance, feeder: RevealFeeder, times: list[float], ahead: int
+    ) -> None:
+        self.perf = perf
+        self.feeder = feeder
+        self.times = times
+        self.ahead = max(ahead, 1)
+        self.animator = perf.animator
+        self.deferred = _Deferred()
+        perf.animator = self.deferred
+        self.deferred.take()  # the kit map and tuning, which the animator has already
+        self.news: list[list[_Call]] = []
+        self.next = 0
+        self.chunks = FrameChunks(self.animator)  # type: ignore[arg-type]
+
+    def _run_to(self, end: int) -> None:
+        """Feed and commit frames up to ``end`` (exclusive), keeping each one's news."""
+        for t in self.times[len(self.news) : end]:
+            self.feeder.until(self.perf, t)
+            self.perf.advance(t)
+            self.news.append(self.deferred.take())
+
+    def _tell(self, calls: list[_Call]) -> None:
+        for name, args in calls:
+            getattr(self.animator, name)(*args)
+
+    def scene(self, t: float) -> DrawList:
+        i = self.next
+        if i >= len(self.times) or self.times[i] != t:
+            raise ValueError("the offline frames are drawn once each, in order")
+        self.next += 1
+        if i >= len(self.news):
+            self._run_to(i + self.ahead)
+        news, self.news[i] = self.news[i], []
+        if news:
+            self._tell(news)
+            self.chunks.invalidate()
+        if not self.chunks.has(t):
+            j = i + 1
+            while j < len(self.news) and not self.news[j]:
+                j += 1
+            self.chunks.prepare(self.times[i:j])
+        return self.chunks.scene(t)
+
+    def close(self) -> None:
+        """Give the performance its animator back, told everything it was told so far."""
+        self.perf.animator = self.animator
+        for calls in self.news[self.next :]:
+            self._tell(calls)
+        self._tell(self.deferred.take())
+        self.news = []

@@ -6,8 +6,13 @@ Figures (each as a ratio to its target; >= 1.00x meets it):
   plan_ms_p99              planning one beat of 16 notes per performer         (target 1 ms)
   pose_ms                  sampling + blending + FK of both players / frame    (target 1 ms)
   pose_scene_ms            pose and building the frame's instances / frame     (target 0.5 ms)
+                           both as the render loops do it: the offline render's
+                           loop over the demo, posing each stretch of frames until
+                           the animator's next news at once, amortised per frame
+                           (one frame at a time, and 30-frame chunks, beside it)
   gl_draw_ms               GL draw of one 1280x720 frame until finished        (1.5x the fps before)
   render_fps               the full band at 1280x720 headless, no readback     (1.5x the fps before)
+                           (posed and built as the offline render does)
   render_fps_readback      the same with readback, as for video                (1.5x the fps before)
   offline_realtime_factor  `virja render` of the demo to .mp4 with sound       (target 2x)
   jam_key_to_impact_ms     key through JACK to the frame showing its impact    (target 35 ms)

@@ -23,6 +23,16 @@ FORGET_EVERY = 60  # frames between forgets
 AHEAD_FRAMES = 6  # the band is posed for this many slots at once (thrown away on news)
 
 
+def _changes_pose(animator: Any, item: tuple[Any, ...]) -> bool:
+    """Whether an inbox item may change the animator's poses (chords, the clock and a
+    drum's note-off do not: ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
+    if item[0] in ("chord", "clock", "stop"):
+        return False
+    if item[0] == "off":
+        return item[1] in getattr(animator, "NOTE_OFF_PERFORMERS", (item[1],))
+    return True
+
+
 class FrameSink(Protocol):
     """A consumer of drawn poses: ``show`` one frame; ``closed`` when it wants to stop."""
 
@@ -96,7 +106,7 @@ class FrameLoop:
         posed ahead are thrown away when it is told anything)."""
         while (item := self.inbox.get()) is not None:
             kind = item[0]
-            if self.chunks is not None and kind not in ("chord", "clock", "stop"):
+            if self.chunks is not None and _changes_pose(self.animator, item):
                 self.chunks.invalidate()
             if kind == "planned":
                 self.animator.add_planned(item[1])

@@ -277,9 +277,12 @@ class BandAnimator:
         else:
             raise UnknownMotionError(f"no figure for performer {p.performer!r}")
 
+    # whose note-offs change the band's pose (the render loops pose ahead across the others)
+    NOTE_OFF_PERFORMERS: frozenset[str] = frozenset({"bass"})
+
     def note_off(self, performer: str, event: Any) -> None:
         """A note-off: the bassist's fingers lift from the string (an open string rings on)."""
-        if performer == "bass":
+        if performer in self.NOTE_OFF_PERFORMERS:
             self.bassist.note_off(int(event.note), float(event.time_s))
 
     def _hold(self, name: str, p: PlannedNoteLike) -> Instance:

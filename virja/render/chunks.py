@@ -15,6 +15,7 @@ for the stretch of frames until the animator's next news; the live window
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -37,9 +38,10 @@ class FrameChunks:
     """Poses and scenes of ``animator`` for frame times prepared a chunk at a time.
 
     ``prepare(times)`` computes a chunk (times ascending); ``scene(t)`` and
-    ``pose(t)`` return a prepared frame, or compute ``t`` alone when it was not
+    ``frame(t)`` return a prepared frame, or compute ``t`` alone when it was not
     prepared.  ``chunks`` and ``frames`` count what was computed, ``served`` what
-    was asked.
+    was asked, ``pose_s`` and ``scene_s`` the seconds spent posing and building
+    instances (``virja bench``'s pose_ms and pose_scene_ms).
     """
 
     def __init__(self, animator: BatchAnimator, geo: Geometry = GEOMETRY) -> None:
@@ -51,6 +53,8 @@ class FrameChunks:
         self.chunks = 0
         self.frames = 0
         self.served = 0
+        self.pose_s = 0.0
+        self.scene_s = 0.0
 
     def invalidate(self) -> None:
         """The animator learnt something: every prepared frame is thrown away."""
@@ -64,8 +68,12 @@ class FrameChunks:
     def prepare(self, times: Sequence[float]) -> None:
         """Compute the frames at ``times`` (ascending) now, replacing the chunk held."""
         ts = np.asarray(times, dtype=np.float64)
+        a = time.perf_counter()
         self._batch = self.animator.pose_batch(ts)
+        b = time.perf_counter()
         self._scenes = band_scenes(self._batch, self.geo)
+        self.pose_s += b - a
+        self.scene_s += time.perf_counter() - b
         self._index = {t: k for k, t in enumerate(ts.tolist())}
         self.chunks += 1
         self.frames += ts.size

@@ -306,7 +306,19 @@ class _Ahead:
         for t in self.times[len(self.news) : end]:
             self.feeder.until(self.perf, t)
             self.perf.advance(t)
-            self.news.append(self.deferred.take())
+            calls = self.deferred.take()
+            if calls and not any(self._changes_pose(c) for c in calls):
+                self._tell(calls)  # told now: nothing of the pose depends on it
+                calls = []
+            self.news.append(calls)
+
+    def _changes_pose(self, call: _Call) -> bool:
+        """Whether a call may change the animator's poses (a drum's note-off does not:
+        ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
+        name, args = call
+        if name != "note_off":
+            return True
+        return args[0] in getattr(self.animator, "NOTE_OFF_PERFORMERS", (args[0],))
 
     def _tell(self, calls: list[_Call]) -> None:
         for name, args in calls:

@@ -325,10 +325,10 @@ def pose_scene_ms(frames: int = 600) -> PoseSceneFigures:
     from virja.render.chunks import FrameChunks
     from virja.render.scene import band_scene
 
-    chunks = None
-    for _scene, chunks in demo_frames(frames):
+    loop = demo_frames(frames)
+    _scene, chunks = next(loop)
+    for _scene, _chunks in loop:
         pass
-    assert chunks is not None
     n = max(chunks.frames, 1)
     animator, t0, t1 = _demo_animator()
     times = np.linspace(t0, t1, frames).tolist()

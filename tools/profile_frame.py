@@ -1,11 +1,16 @@
-"""Where one offline frame's time goes: pose, scene building, GL draw, read-back, encode.
+"""Where one offline frame's time goes: planning, pose, scene building, GL draw,
+read-back, encode.
 
     .venv/bin/python tools/profile_frame.py [--frames 300] [--size 1280x720] [--cprofile]
 
-Runs the demo (virja/demo/blues.mid) frame by frame at 30 fps, timing each
-stage alone (the GL draw is closed with ``ctx.finish()`` so its cost is not
-moved into the read-back), and prints the median ms per stage.  With
-``--cprofile`` it also prints the top functions of the CPU path (pose + scene).
+Runs the demo (virja/demo/blues.mid) through the offline render's own frame path
+(``virja.bench.demo_frames``: the timer run ahead, the band posed and its
+instances built a stretch of frames at a time until the animator's next news),
+then draws each frame at 30 fps, timing each stage alone (the GL draw is closed
+with ``ctx.finish()`` so its cost is not moved into the read-back), and prints
+the mean ms per frame of the CPU stages (a chunk's cost is spread over its
+frames) and the median of the GL ones.  With ``--cprofile`` it also prints the
+top functions of the CPU path (planning, pose, scene).
 """
 
 from __future__ import annotations
@@ -15,15 +20,14 @@ import cProfile
 import pstats
 import statistics
 import time
+from pathlib import Path
 
-import numpy as np
-
-from virja.bench import _demo_animator
+from virja.bench import demo_frames
 from virja.render.camera import PRESETS
 from virja.render.hosts import OffscreenTarget, create_headless_context
 from virja.render.offline import parse_size
 from virja.render.renderer import Renderer
-from virja.render.scene import band_scene, static_scene
+from virja.render.scene import static_scene
 from virja.render.video import VideoWriter
 
 
@@ -34,53 +38,67 @@ def main() -> None:
     ap.add_argument("--cprofile", action="store_true")
     args = ap.parse_args()
     size = parse_size(args.size)
-    animator, t0, t1 = _demo_animator()
-    times = t0 + (np.arange(args.frames) / 30.0) % max(t1 - t0, 1e-3)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     target = OffscreenTarget(ctx, size, samples=1)
     static = static_scene()
     cam = PRESETS["front"]
-    writer = VideoWriter(
-        __import__("pathlib").Path("/tmp/virja-profile.mp4"), size, 30.0, bottom_up=True
-    )
-    stages: dict[str, list[float]] = {
-        k: [] for k in ("pose", "scene", "draw", "readback", "encode")
-    }
+    writer = VideoWriter(Path("/tmp/virja-profile.mp4"), size, 30.0, bottom_up=True)
+    cpu = {"plan + feed": 0.0, "pose": 0.0, "scene": 0.0}
+    gl: dict[str, list[float]] = {k: [] for k in ("draw", "readback", "encode")}
     prof = cProfile.Profile() if args.cprofile else None
+    frames = chunks_done = 0
+    chunks = None
+    loop = demo_frames(args.frames)
     try:
-        for t in times.tolist():
+        while True:
             a = time.perf_counter()
             if prof:
                 prof.enable()
-            pose = animator.pose(t)
+            before = (chunks.pose_s, chunks.scene_s) if chunks is not None else (0.0, 0.0)
+            try:
+                dl, chunks = next(loop)
+            except StopIteration:
+                break
+            finally:
+                if prof:
+                    prof.disable()
             b = time.perf_counter()
-            dl = band_scene(pose)
-            c = time.perf_counter()
-            if prof:
-                prof.disable()
+            pose_s, scene_s = chunks.pose_s - before[0], chunks.scene_s - before[1]
+            cpu["pose"] += pose_s
+            cpu["scene"] += scene_s
+            cpu["plan + feed"] += (b - a) - pose_s - scene_s
             renderer.draw([static, dl], cam, target.fbo)
             ctx.finish()
-            d = time.perf_counter()
+            c = time.perf_counter()
             raw = target.read_raw_rgb()
-            e = time.perf_counter()
+            d = time.perf_counter()
             writer.write_raw(raw)
-            f = time.perf_counter()
-            for k, dt in zip(stages, (b - a, c - b, d - c, e - d, f - e), strict=True):
-                stages[k].append(dt * 1000)
+            e = time.perf_counter()
+            for k, dt in zip(gl, (c - b, d - c, e - d), strict=True):
+                gl[k].append(dt * 1000)
+            frames += 1
+            chunks_done = chunks.chunks
     finally:
         writer.close()
         target.release()
         renderer.release()
         ctx.release()
     total = 0.0
-    for k, ms in stages.items():
-        med = statistics.median(ms[5:])
+    print(
+        f"{frames} frames, posed in {chunks_done} chunks ({frames / max(chunks_done, 1):.1f} a chunk)"
+    )
+    for k, s in cpu.items():
+        ms = s / max(frames, 1) * 1000
+        total += ms
+        print(f"{k:12s} {ms:8.3f} ms mean per frame")
+    for k, ms_list in gl.items():
+        med = statistics.median(ms_list[5:] or ms_list)
         total += med
-        print(f"{k:9s} {med:8.3f} ms median")
-    print(f"{'sum':9s} {total:8.3f} ms  ({1000 / total:.1f} frames/s serial)")
+        print(f"{k:12s} {med:8.3f} ms median")
+    print(f"{'sum':12s} {total:8.3f} ms  ({1000 / total:.1f} frames/s serial)")
     if prof:
-        pstats.Stats(prof).sort_stats("cumulative").print_stats(25)
+        pstats.Stats(prof).sort_stats("cumulative").print_stats(30)
 
 
 if __name__ == "__main__":

@@ -270,7 +270,17 @@ def blend_many(tl: Timeline, times: np.ndarray, below: np.ndarray) -> np.ndarray
     instance at full weight replaces what lies below, as in :meth:`Timeline.blend`.
     """
     acc = below.copy()
-    for inst in tl._items:
+    if not times.size:
+        return acc
+    # only the instances that can cover one of the times: those started by the last,
+    # back to the first that has ended by the first (the scan :meth:`Timeline.active`
+    # makes), not the whole timeline: a render loop asks a few frames at a time
+    first, last = float(times[0]), float(times[-1])
+    hi_k = bisect.bisect_right(tl._starts, last)
+    lo_k = hi_k
+    while lo_k > 0 and tl._items[lo_k - 1].end > first:
+        lo_k -= 1
+    for inst in tl._items[lo_k:hi_k]:
         lo = int(np.searchsorted(times, inst.start, side="left"))
         hi = int(np.searchsorted(times, inst.end, side="left"))
         if hi <= lo:

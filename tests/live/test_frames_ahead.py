@@ -74,6 +74,14 @@ def test_frames_are_posed_ahead_and_a_late_note_is_in_the_next_frame() -> None:
     assert not _same(pose, scene, BandAnimator().pose(pose.time_s))  # which shows
     for p, s in window.frames[:-1]:  # and the frames before it were the animator's own
         assert _same(p, s, BandAnimator().pose(p.time_s))
+    # the frame with the news was posed alone (no dearer than frame by frame); the
+    # next ones a chunk again
+    assert (loop.chunks.chunks, loop.chunks.frames) == (3, 2 * AHEAD_FRAMES + 1)
+    for _ in range(AHEAD_FRAMES):
+        assert loop.step()
+    assert (loop.chunks.chunks, loop.chunks.frames) == (4, 3 * AHEAD_FRAMES + 1)
+    for p, s in window.frames[-AHEAD_FRAMES:]:
+        assert _same(p, s, told.pose(p.time_s))
 
 
 def test_with_vsync_the_band_is_posed_one_slot_at_a_time() -> None:

@@ -100,6 +100,7 @@ class FrameLoop:
             from virja.render.chunks import FrameChunks
 
             self.chunks = FrameChunks(animator)  # type: ignore[arg-type]
+        self._news = False  # the animator was told something since the last frame
 
     def drain(self) -> None:
         """Everything the planning side sent so far, into the animator (the frames
@@ -108,6 +109,7 @@ class FrameLoop:
             kind = item[0]
             if self.chunks is not None and _changes_pose(self.animator, item):
                 self.chunks.invalidate()
+                self._news = True
             if kind == "planned":
                 self.animator.add_planned(item[1])
                 self.received += 1
@@ -165,14 +167,17 @@ class FrameLoop:
         """The pose (and, for a BandAnimator, its instances) of the slot shown at
         ``show_at``: from the frames posed ahead when it is one of them, else posed
         with the next slots as the pacer will ask for them (without vsync the slots
-        are a period apart; with it, the swap decides: one frame at a time)."""
+        are a period apart; with it, the swap decides: one frame at a time).  A frame
+        right after news is posed alone: it shows the news (a key just played) no
+        later than one posed frame by frame would; the chunk starts with the next."""
         t = self.anchor_s + show_at
+        news, self._news = self._news, False
         if self.chunks is None:
             return self.animator.pose(t), None
         if not self.chunks.has(t):
             times = [t]
             shows = show_at
-            for _ in range(0 if self.pacer.vsync else AHEAD_FRAMES - 1):
+            for _ in range(0 if self.pacer.vsync or news else AHEAD_FRAMES - 1):
                 shows += self.pacer.period_s  # as FramePacer adds it, slot after slot
                 times.append(self.anchor_s + shows)
             self.chunks.prepare(times)

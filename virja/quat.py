@@ -181,48 +181,28 @@ def from_matrix(m: ArrayLike) -> F:
     if r.shape[-2:] != (3, 3):
         raise ValueError(f"rotation matrices need shape (..., 3, 3), got {r.shape}")
     # Shepperd's method, vectorised: pick the largest of 4 candidates per matrix.
+    # (written into one array: a stack of stacks cost more than the arithmetic)
     tr = r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2]
-    cand = np.stack(
-        [
-            np.stack(
-                [
-                    1 + tr,
-                    r[..., 2, 1] - r[..., 1, 2],
-                    r[..., 0, 2] - r[..., 2, 0],
-                    r[..., 1, 0] - r[..., 0, 1],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 2, 1] - r[..., 1, 2],
-                    1 + 2 * r[..., 0, 0] - tr,
-                    r[..., 0, 1] + r[..., 1, 0],
-                    r[..., 0, 2] + r[..., 2, 0],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 0, 2] - r[..., 2, 0],
-                    r[..., 0, 1] + r[..., 1, 0],
-                    1 + 2 * r[..., 1, 1] - tr,
-                    r[..., 1, 2] + r[..., 2, 1],
-                ],
-                axis=-1,
-            ),
-            np.stack(
-                [
-                    r[..., 1, 0] - r[..., 0, 1],
-                    r[..., 0, 2] + r[..., 2, 0],
-                    r[..., 1, 2] + r[..., 2, 1],
-                    1 + 2 * r[..., 2, 2] - tr,
-                ],
-                axis=-1,
-            ),
-        ],
-        axis=-2,
+    d21, d02, d10 = (
+        r[..., 2, 1] - r[..., 1, 2],
+        r[..., 0, 2] - r[..., 2, 0],
+        r[..., 1, 0] - r[..., 0, 1],
     )
+    s01, s02, s12 = (
+        r[..., 0, 1] + r[..., 1, 0],
+        r[..., 0, 2] + r[..., 2, 0],
+        r[..., 1, 2] + r[..., 2, 1],
+    )
+    cand = np.empty(r.shape[:-2] + (4, 4))
+    rows = (
+        (1 + tr, d21, d02, d10),
+        (d21, 1 + 2 * r[..., 0, 0] - tr, s01, s02),
+        (d02, s01, 1 + 2 * r[..., 1, 1] - tr, s12),
+        (d10, s02, s12, 1 + 2 * r[..., 2, 2] - tr),
+    )
+    for i, row in enumerate(rows):
+        for j, value in enumerate(row):
+            cand[..., i, j] = value
     diag = np.stack([tr, r[..., 0, 0], r[..., 1, 1], r[..., 2, 2]], axis=-1)
     best = np.argmax(diag, axis=-1)
     q = np.take_along_axis(cand, best[..., None, None], axis=-2)[..., 0, :]

@@ -46,6 +46,9 @@ BassState = HandState | None  # the left hand (never on an open string)
 BassOption = tuple[Position, ...]  # one position per kept note, melody first
 
 DEFAULT_FINGERING = Fingering()
+# the highest fret of any fingerboard (BassSetup allows 36): no hand position or
+# shift is larger
+_MAX_POSITION = 36
 
 
 def motion_key(string: str, fret: int, hand: BassState) -> BassPluck:
@@ -216,7 +219,14 @@ def solve(
     best: dict[BassState, float] = {state: 0.0}
     backs: list[dict[BassState, tuple[BassState, int, float]]] = []
     per = fingering.position_cost_per_fret
-    span = fingering.span
+    shift_cost = fingering.shift_cost
+    shift_per_fret = fingering.shift_cost_per_fret
+    rushed = fingering.rushed_shift_cost
+    # span(h0) and shift_time(d) looked up by index (the same floats as the calls);
+    # positions and shifts never exceed the frets of any fingerboard (36)
+    top = _MAX_POSITION + 1
+    spans = [fingering.span(h) for h in range(top)]
+    shift_times = [fingering.shift_time(d) for d in range(top)]
     for gi, options in enumerate(groups):
         gap = math.inf if gaps is None else gaps[gi]
         # :func:`transitions` inlined, with what does not depend on the previous state
@@ -241,20 +251,15 @@ def solve(
                 else:
                     s0, f0, h0 = prev
                     base = float(abs(a[1] - f0) + abs(a[0] - s0))
-                    if h0 <= low and high <= h0 + span(h0):
+                    if h0 <= low and high <= h0 + spans[h0]:
                         moves = [(base + per * (h0 - 1), (a[0], a[1], h0))]
                     else:
                         moves = []
                         for h in hs:
                             d = abs(h - h0)
-                            c = (
-                                base
-                                + fingering.shift_cost
-                                + fingering.shift_cost_per_fret * d
-                                + per * (h - 1)
-                            )
-                            if gap < fingering.shift_time(d):
-                                c += fingering.rushed_shift_cost
+                            c = base + shift_cost + shift_per_fret * d + per * (h - 1)
+                            if gap < shift_times[d]:
+                                c += rushed
                             moves.append((c, (a[0], a[1], h)))
                 for c, new in moves:
                     total = acc + c

@@ -21,11 +21,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import cast
 
 from virja.plan.bounds import keep_best
 from virja.plan.config import DrumCosts, Timing
-from virja.vocab import Hand
+from virja.vocab import HAND_PIECES, Hand
 
 LEFT: Hand = "left_hand"
 RIGHT: Hand = "right_hand"
@@ -158,9 +157,21 @@ class _Option:
 
 # A played option flattened for the solver's inner loop: (option index, the right
 # hand's piece and its stroke's dt (None, 0.0 when the right hand does not play), the
-# same for the left hand, motion that ends the group (the next row), penalty, first
-# played motion, table cost first -> second played motion (0.0 for one stroke)).
-_Played = tuple[int, str | None, float, str | None, float, int, float, int, float]
+# least time the right hand needs since its last stroke, by the piece it struck
+# (:meth:`Timing.gap` less TIME_EPS_S; -inf for every piece when it does not play),
+# the same three for the left hand, motion that ends the group (the next row),
+# penalty, first played motion, table cost first -> second played motion (0.0 for
+# one stroke)).
+_Need = dict[str | None, float]
+_Played = tuple[int, str | None, float, _Need, str | None, float, _Need, int, float, int, float]
+
+
+def _needs(timing: Timing, piece: str | None) -> _Need:
+    """``Timing.gap(prev, piece) - TIME_EPS_S`` for every previous piece of a hand (none
+    included): the same floats :func:`transition` compares with, looked up once."""
+    if piece is None:
+        return dict.fromkeys((None, *HAND_PIECES), -math.inf)
+    return {prev: timing.gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
 
 
 @dataclass(frozen=True, slots=True)
@@ -198,8 +209,10 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     k,
                     r_piece,
                     r_dt,
+                    _needs(timing, r_piece),
                     l_piece,
                     l_dt,
+                    _needs(timing, l_piece),
                     last,
                     penalty,
                     first,
@@ -286,7 +299,6 @@ def solve(
     least objective, in their order; no effect on a layer that is not larger.
     """
     max_interval = timing.max_gap
-    gap = timing.gap
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
@@ -311,8 +323,9 @@ def solve(
         ] = {}
         index: dict[HandState, int] = {}  # next layer: state -> its number
         nxt: list[HandState] = []
-        # None until reached; every state is reached by the candidate that numbers it
-        nacc: list[float | None] = []
+        # inf until reached (every total is finite); every state is reached by the
+        # candidate that numbers it
+        nacc: list[float] = []
         back_s: list[int] = []
         back_k: list[int] = []
         for sid, acc in enumerate(accs):
@@ -335,10 +348,21 @@ def solve(
                 since_r = inf if t_right is None else t - t_right
                 since_l = inf if t_left is None else t - t_left
                 moves: list[_Move] = []
-                for k, r_piece, r_dt, l_piece, l_dt, last, penalty, first, pair in played_opts:
-                    if r_piece is not None and since_r + r_dt < gap(p_right, r_piece) - TIME_EPS_S:
-                        continue
-                    if l_piece is not None and since_l + l_dt < gap(p_left, l_piece) - TIME_EPS_S:
+                for (
+                    k,
+                    r_piece,
+                    r_dt,
+                    r_need,
+                    l_piece,
+                    l_dt,
+                    l_need,
+                    last,
+                    penalty,
+                    first,
+                    pair,
+                ) in played_opts:
+                    # a hand that does not play needs -inf: never infeasible
+                    if since_r + r_dt < r_need[p_right] or since_l + l_dt < l_need[p_left]:
                         continue
                     nr, npr = keep_r, keep_pr
                     if r_piece is not None:
@@ -353,7 +377,7 @@ def solve(
                     if nid is None:
                         nid = index[new] = len(nxt)
                         nxt.append(new)
-                        nacc.append(None)
+                        nacc.append(inf)
                         back_s.append(0)
                         back_k.append(0)
                     moves.append((k, penalty, first, pair, nid))
@@ -363,8 +387,7 @@ def solve(
             row = table[prev] if prev is not None and recent else none_row
             for k, penalty, first, pair, nid in moves:
                 total = acc + penalty + row[first] + pair
-                old = nacc[nid]
-                if old is None or total < old:
+                if total < nacc[nid]:
                     nacc[nid] = total
                     back_s[nid] = sid
                     back_k[nid] = k
@@ -378,23 +401,22 @@ def solve(
             if nid is None:
                 nid = index[dropped] = len(nxt)
                 nxt.append(dropped)
-                nacc.append(None)
+                nacc.append(inf)
                 back_s.append(0)
                 back_k.append(0)
             total = acc + drop_pen
-            old = nacc[nid]
-            if old is None or total < old:
+            if total < nacc[nid]:
                 nacc[nid] = total
                 back_s[nid] = sid
                 back_k[nid] = drop_k
         if beam is not None:
-            kept = keep_best(cast(list[float], nacc), beam)
+            kept = keep_best(nacc, beam)
             if kept is not None:  # cut: the least-cost states, renumbered in order
                 nxt = [nxt[i] for i in kept]
                 nacc = [nacc[i] for i in kept]
                 back_s = [back_s[i] for i in kept]
                 back_k = [back_k[i] for i in kept]
-        layer, accs = nxt, cast(list[float], nacc)
+        layer, accs = nxt, nacc
         layers.append(nxt)
         backs.append((back_s, back_k))
     # the first state (in layer order) of least objective

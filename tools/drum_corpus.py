@@ -7,7 +7,7 @@ Each file goes through the same planner as `virja plan FILE` (notes read
 --lookahead-beats ahead).  Prints per reason the dropped drum notes over the
 whole corpus, the notes no kit drummer plays (routed to nobody), late notes,
 and the files with the most drops (--show N).  Exit status 1 when any kit note
-was dropped for a reason other than too_many_hands (three or more hand pieces
+was dropped for a reason other than three_pieces_at_once (three or more hand pieces
 within the grouping window, which no two hands can play).
 """
 
@@ -22,7 +22,7 @@ from pathlib import Path
 from virja.input import midi_input
 from virja.pipeline import PerformanceSettings, perform
 
-ALLOWED = {"too_many_hands"}
+ALLOWED = {"three_pieces_at_once"}
 
 
 def plan_file(

@@ -97,7 +97,7 @@ def test_kick_doubles_and_a_beater_rebound_are_played() -> None:
 
 def test_three_hand_pieces_within_30_ms_is_its_own_reason() -> None:
     planned, report = _plan([(0.0, 38, 90), (0.01, 49, 90), (0.02, 45, 90)])
-    assert [d.reason for d in report.dropped] == ["too_many_hands"]
+    assert [d.reason for d in report.dropped] == ["three_pieces_at_once"]
     assert len(planned) == 2
 
 

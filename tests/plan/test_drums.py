@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import random
 
@@ -54,15 +55,39 @@ def test_snare_sixteenths_with_ride_eighths_snare_left_ride_right(config: PlanCo
 def test_a_hand_is_not_asked_to_strike_faster_than_its_minimum_interval(
     config: PlanConfig,
 ) -> None:
-    # four snare strokes 12 ms apart, a hand's double takes 30 ms: one is dropped
+    # four snare strokes 6 ms apart, a hand's double takes 30 ms, 15 ms at a stretch
+    # (a pressed double): one is dropped
     assert config.timing.get("snare").min_interval_s == 0.03
-    groups = [HandGroup(i * 0.012, (SD,)) for i in range(4)]
+    assert config.timing.stretch_gap("snare", "snare") == 0.015
+    groups = [HandGroup(i * 0.006, (SD,)) for i in range(4)]
     sol = drums.solve(config.costs, config.timing, drums.START, groups)
     hands = [a[0] for a in sol.assignments]
     assert hands.count(None) == 1
     played = [(g.time, h) for g, h in zip(groups, hands, strict=True) if h is not None]
     for (t1, h1), (t2, h2) in itertools.pairwise(played):
-        assert h1 != h2 or t2 - t1 >= 0.03 - 1e-9
+        assert h1 != h2 or t2 - t1 >= 0.015 - 1e-9
+    # 12 ms apart: alternating hands, 24 ms per hand, is a pressed double at a stretch
+    groups = [HandGroup(i * 0.012, (SD,)) for i in range(4)]
+    sol = drums.solve(config.costs, config.timing, drums.START, groups)
+    assert [a[0] for a in sol.assignments] == [LEFT, RIGHT, LEFT, RIGHT]
+    assert sol.total == 2 + 2 * config.timing.stretch_penalty  # two stretched strokes
+
+
+def test_the_stretch_is_only_taken_where_a_note_would_be_dropped(config: PlanConfig) -> None:
+    # without the stretch the same plan (the paper's sixteenths at 120 bpm need none)
+    plain = dataclasses.replace(config.timing, stretch_interval_s=None)
+    groups = [HandGroup(i * 0.125, (SD,)) for i in range(4)]
+    a = drums.solve(config.costs, config.timing, drums.START, groups)
+    b = drums.solve(config.costs, plain, drums.START, groups)
+    assert a == b
+    # ride and high tom, then the tom again 30.6 ms later (GMD drummer2 session1 take 2,
+    # 1.04 s): no hand can play it in the tom's 35 ms, the left hand does at a stretch
+    tom = Stroke("tom_high", 2)
+    groups = [HandGroup(0.0, (RD, tom)), HandGroup(0.0306, (tom,)), HandGroup(0.1, (RD,))]
+    dropped = drums.solve(config.costs, plain, drums.START, groups).assignments
+    assert None in [h for a in dropped for h in a]
+    sol = drums.solve(config.costs, config.timing, drums.START, groups)
+    assert None not in [h for a in sol.assignments for h in a]
 
 
 def test_moving_between_pieces_takes_longer_the_farther_they_are(config: PlanConfig) -> None:
@@ -109,15 +134,21 @@ def _objective(config: PlanConfig, groups: list[HandGroup], assigns: list[tuple]
         played = [(h, s) for s, h in zip(g.strokes, a, strict=True) if h is not None]
         if len({h for h, _ in played}) != len(played):
             return None
-        for s, h in zip(g.strokes, a, strict=True):
+        for i, (s, h) in enumerate(zip(g.strokes, a, strict=True)):
+            pair = len(g.strokes) == 2 and a[1 - i] is not None
+            if h is None and pair and g.strokes[1 - i].piece == s.piece:
+                total += timing.stretch_penalty  # a flam by one hand, at a stretch
+                continue
             if h is None:
                 total += c.drop_penalty + 9 - s.priority
         for h, s in sorted(played, key=lambda p: p[0] != LEFT):
             seq.append((g.time, h, s.piece))
     last: dict[str, tuple[float, str]] = {}
     for k, (t, h, piece) in enumerate(seq):
-        if h in last and t - last[h][0] < timing.gap(last[h][1], piece) - 1e-9:
+        if h in last and t - last[h][0] < timing.stretch_gap(last[h][1], piece) - 1e-9:
             return None
+        if h in last and t - last[h][0] < timing.gap(last[h][1], piece) - 1e-9:
+            total += timing.stretch_penalty  # the hand at a stretch
         last[h] = (t, piece)
         if k == 0 or t - seq[k - 1][0] >= timing.rest_s:
             row = c.none_row

@@ -71,8 +71,8 @@ def test_no_limb_is_in_two_places_at_once(config: PlanConfig) -> None:
                     if b.limb == "left_foot":
                         kind = "hihat_pedal"
                     gap = config.timing.get(kind).min_interval_s
-                    if b.limb in ("left_hand", "right_hand"):
-                        gap = config.timing.gap(a.piece, b.piece or "")
+                    if b.limb in ("left_hand", "right_hand"):  # at a stretch at most
+                        gap = config.timing.stretch_gap(a.piece, b.piece or "")
                     dt = b.time - a.time
                     # or a rebound of the stroke before on the same piece (a buzz, a
                     # pad's double trigger) within the grouping window
@@ -241,7 +241,7 @@ def test_more_hand_notes_than_hands_keep_the_most_important() -> None:
         ("hihat", "left_foot"),
     }
     assert sorted(d.note.note for d in report.dropped) == [49]
-    assert {d.reason for d in report.dropped} == {"too_many_hands"}
+    assert {d.reason for d in report.dropped} == {"three_pieces_at_once"}
 
 
 def test_doubled_drum_note_shares_one_stroke() -> None:

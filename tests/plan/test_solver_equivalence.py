@@ -10,6 +10,7 @@ per-stroke cost, state and total must be identical, ties included.
 
 from __future__ import annotations
 
+import dataclasses
 import random
 from collections.abc import Sequence
 
@@ -35,7 +36,7 @@ def _reference_drums(
             plays, penalty = [], 0.0
             for i, (stroke, hand) in enumerate(zip(group.strokes, assign, strict=True)):
                 if hand is None:
-                    penalty += drums.drop_penalty(costs, stroke)
+                    penalty += drums.unplayed_penalty(costs, timing, group.strokes, assign, i)
                 else:
                     plays.append((hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, i))
             plays.sort(key=lambda p: p[0])  # left hand first
@@ -47,14 +48,20 @@ def _reference_drums(
             prev, prev_t, t_right, t_left, p_right, p_left = st
             row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
             for k, (_assign, played, penalty) in enumerate(compiled):
-                row, tr, tl, total, ok = row0, t_right, t_left, acc + penalty, True
-                pr, pl = p_right, p_left
-                for is_right, m, piece, i in played:
+                # feasible at all (stretch_gap), and at a stretch (gap) for how many
+                ok, stretched = True, penalty
+                for is_right, _m, piece, i in played:
                     last, lp = (t_right, p_right) if is_right else (t_left, p_left)
                     ts = t + group.strokes[i].dt
-                    if last is not None and ts - last < timing.gap(lp, piece) - drums.TIME_EPS_S:
+                    eps = drums.TIME_EPS_S
+                    if last is not None and ts - last < timing.stretch_gap(lp, piece) - eps:
                         ok = False
-                        break
+                    elif last is not None and ts - last < timing.gap(lp, piece) - eps:
+                        stretched = stretched + timing.stretch_penalty
+                row, tr, tl, total = row0, t_right, t_left, acc + stretched
+                pr, pl = p_right, p_left
+                for is_right, m, piece, i in played:
+                    ts = t + group.strokes[i].dt
                     total += table[none_row if row is None else row][m]
                     row = m
                     if is_right:
@@ -135,6 +142,14 @@ def _random_case(
         }
         moves = rng.choice([{}, timing.moves])  # no moves: every gap is min_interval_s
         timing = Timing(timing.reference_spb, rng.choice([0.0, 0.1, 1.5]), kinds, moves)
+    if rng.random() < 0.5:  # the hand's stretch: none, or tight and costly or cheap
+        floor = rng.choice([None, 0.0, 0.02, 0.05])
+        timing = dataclasses.replace(
+            timing,
+            stretch_interval_s=floor,
+            stretch_moves=rng.choice([{}, config.timing.stretch_moves]),
+            stretch_penalty=rng.choice([0.0, 0.5, 150.0]),
+        )
     state = drums.START
     if rng.random() < 0.3:  # a fixed state left by an earlier plan
         t_right = rng.choice([None, -0.02, -0.1])

@@ -238,7 +238,7 @@ def _drummer_table(rep: MotionReport, drummer: DrummerFigures, drops: Counter[st
     d = _figure(_split(rep)["drums"])
     agree = drummer.hihat_agreement
     hits = {k: v for k, v in drummer.collisions.items() if v}
-    real_drops = {k: v for k, v in drops.items() if k != "too_many_hands"}
+    real_drops = {k: v for k, v in drops.items() if k != "three_pieces_at_once"}
     rows = [
         (
             "contact at impact (max)",
@@ -286,7 +286,7 @@ def _drummer_table(rep: MotionReport, drummer: DrummerFigures, drops: Counter[st
         (
             "dropped",
             ", ".join(f"{k} {v}" for k, v in sorted(drops.items())) or "0",
-            "0 (but too_many_hands)",
+            "0 (but three_pieces_at_once)",
             not real_drops,
         ),
     ]

@@ -14,6 +14,7 @@ left foot (:meth:`virja.plan.chain_feet.FootChain.chick`).  Shared rules:
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from virja.plan import drums as drums_mod
@@ -21,7 +22,6 @@ from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld
 from virja.plan.config import DrumNote
-from virja.plan.types import DropReason
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
 # double trigger): the later ones ride on the first stroke, each at its own time.
@@ -60,13 +60,18 @@ class HandGroupPlan:
     extra: list[DrumHeld]
 
 
-def hand_group(group: list[DrumHeld], t0: float) -> HandGroupPlan:
+def hand_group(
+    group: list[DrumHeld], t0: float, chick: Callable[[float], bool] | None = None
+) -> HandGroupPlan:
     """The strokes of a group: notes of one piece within SAME_STROKE_S are one stroke.
 
-    The two most important strokes (velocity-weighed priority, then the earlier)
-    are planned; a further stroke on a piece already planned is a bounce of the
+    The most important stroke (velocity-weighed priority, then the earlier) and the
+    most important one on another piece (on the same piece when there is no other:
+    a flam) are planned; a further stroke on a piece already planned is a bounce of the
     nearest planned stroke there (a buzz or a drag's second note, same hand); a
     third distinct piece within the window is more than two hands can strike.
+    ``chick(t)``: whether the left foot can take a hi-hat stroke at ``t``
+    (``Stroke.foot``: when both hands are busy, a closed hi-hat note is a chick).
     """
     if not group:
         return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
@@ -91,10 +96,15 @@ def hand_group(group: list[DrumHeld], t0: float) -> HandGroupPlan:
         return (prio, c[0].note.time_s, c[0].seq)
 
     ranked = sorted(clusters, key=rank)
-    kept = ranked[:2]
+    # the hands go to two pieces where there are two (a further stroke on one of them
+    # is that hand's double), to a flam or drag on one piece where there is one
+    other = next((c for c in ranked[1:] if c[0].drum.piece != ranked[0][0].drum.piece), None)
+    kept = ranked[:2] if other is None else [ranked[0], other]
     bounces: list[tuple[int, list[DrumHeld]]] = []
     extra: list[DrumHeld] = []
-    for c in ranked[2:]:
+    for c in ranked:
+        if any(c is k for k in kept):
+            continue
         piece = c[0].drum.piece
         near = [
             (abs(k[0].note.time_s - c[0].note.time_s), i)
@@ -106,7 +116,13 @@ def hand_group(group: list[DrumHeld], t0: float) -> HandGroupPlan:
         else:
             extra.extend(c)
     strokes = tuple(
-        drums_mod.Stroke(c[0].drum.piece, rank(c)[0], c[0].note.time_s - t0) for c in kept
+        drums_mod.Stroke(
+            c[0].drum.piece,
+            rank(c)[0],
+            c[0].note.time_s - t0,
+            chick is not None and c[0].drum.piece == "hihat" and chick(c[0].note.time_s),
+        )
+        for c in kept
     )
     return HandGroupPlan(drums_mod.HandGroup(t0, strokes), kept, bounces, extra)
 
@@ -127,20 +143,33 @@ class HandsChain(DrumChain):
     def forget_plan(self) -> None:
         self.plan.forget()
 
-    def _rebounds(self) -> set[int]:
+    def _rebounds(self, groups: list[list[DrumHeld]]) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
         note on the same piece, fixed or pending, within its ``min_interval_s`` (a
-        buzz: soft rebounds of one pressed stroke)."""
+        buzz: soft rebounds of one pressed stroke), and, at any velocity, those
+        within SAME_STROKE_S of an earlier note on the piece in an earlier group (one
+        stroke heard twice, split by the grouping window; in one group the same rule
+        makes them one stroke)."""
         strokes: dict[str, list[float]] = {}
+        group_of = {r.seq: gi for gi, g in enumerate(groups) for r in g}
+        earlier: dict[str, list[tuple[float, int]]] = {}  # piece: (time, group), -1 fixed
         for ft, p in self.fixed:
             if p.piece is not None:
                 strokes.setdefault(p.piece, []).append(ft)
+                earlier.setdefault(p.piece, []).append((ft, -1))
         for r in self.pending:
             strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
+            earlier.setdefault(r.drum.piece, []).append((r.note.time_s, group_of.get(r.seq, -2)))
         for r in self.pending:
             if r.rebound is not None:
                 continue
-            r.rebound = False
+            t, gi = r.note.time_s, group_of.get(r.seq, -2)
+            r.rebound = any(
+                0 < t - s <= SAME_STROKE_S + GROUP_EPS_S and g != gi
+                for s, g in earlier.get(r.drum.piece, ())
+            )
+            if r.rebound:
+                continue
             if r.note.velocity >= BUZZ_VELOCITY:
                 continue
             if r.drum.piece not in BUZZ_PIECES:  # a crash swings away: no rebound
@@ -169,13 +198,15 @@ class HandsChain(DrumChain):
             )
 
     def fix_groups(self, groups: list[list[DrumHeld]], n_groups: int) -> None:
-        rebounds = self._rebounds()
+        rebounds = self._rebounds(groups)
         for g in groups:
             self._decide_foot(g, rebounds)
         aside = rebounds | {r.seq for r in self.pending if r.to_foot}
 
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
-            return hand_group([r for r in g if r.seq not in aside], g[0].note.time_s)
+            return hand_group(
+                [r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick
+            )
 
         def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
             sol = drums_mod.solve(
@@ -202,15 +233,13 @@ class HandsChain(DrumChain):
         rebounds: set[int],
     ) -> None:
         """Emit one group's notes by the solver's ``assignment`` of its strokes."""
-        for r in hp.extra:
+        for r in hp.extra:  # a third hand piece within the window
             if not self.foot.chick(r):
-                self.drop(r, "too_many_hands")
-        # three or more pieces at once: whatever else gives way, gives way to that
-        slow: DropReason = "too_many_hands" if hp.extra else "too_fast"
+                self.drop(r, "three_pieces_at_once")
         late_rebounds = [r for r in group if r.seq in rebounds]
         for r in group:
             if r.to_foot and not self.foot.chick(r):
-                self.drop(r, "too_many_hands")
+                self.drop(r, "three_pieces_at_once")
         for si, stroke in enumerate(hp.group.strokes):
             recs = hp.kept[si]
             hand = assignment[si]
@@ -232,7 +261,7 @@ class HandsChain(DrumChain):
             if hand is None:
                 for r in recs + bounces:
                     if not self.foot.chick(r):
-                        self.drop(r, slow)
+                        self.drop(r, "too_fast")
                 continue
             now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
             self.emit_stroke(now, stroke.piece, hand, stroke_costs[si])

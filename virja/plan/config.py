@@ -14,6 +14,7 @@ relative to the config file).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -189,6 +190,13 @@ class Timing:
     # notes played at once (jam keys, RTP-MIDI: plan.immediate): the shortest stroke is
     # their normal form, so a note is late only when it lands later than that
     immediate: bool = False
+    # the hand's stretch (timing.toml [hand_stretch]): what a hand can do when nothing
+    # else plays every note, at ``stretch_penalty`` per stroke: a double on one piece
+    # down to ``stretch_interval_s``, a move between pieces in ``stretch_moves``.  None:
+    # no stretch (every stroke keeps :meth:`gap`)
+    stretch_interval_s: float | None = None
+    stretch_moves: dict[tuple[str, str], float] = field(default_factory=dict)
+    stretch_penalty: float = 0.0
 
     def get(self, kind: str) -> MotionTiming:
         try:
@@ -204,6 +212,18 @@ class Timing:
         if prev is None or prev == piece:
             return base
         return max(base, self.moves.get((prev, piece), 0.0))
+
+    def stretch_gap(self, prev: str | None, piece: str) -> float:
+        """The least time between two strokes of a hand at a stretch (never more than
+        :meth:`gap`): on one piece ``stretch_interval_s``, between two pieces the
+        stretched move (no shorter than ``stretch_interval_s`` either)."""
+        normal = self.gap(prev, piece)
+        if self.stretch_interval_s is None:
+            return normal
+        floor = self.stretch_interval_s
+        if prev is None or prev == piece:
+            return min(normal, floor)
+        return min(normal, max(floor, self.stretch_moves.get((prev, piece), 0.0)))
 
     @property
     def max_gap(self) -> float:
@@ -278,6 +298,13 @@ class HandMoveTable(Schema):
     speed_m_s: float
 
 
+class HandStretchTable(Schema):
+    min_interval_s: float
+    base_s: float
+    speed_m_s: float
+    penalty: float
+
+
 MotionTimingTable = schema_of(MotionTiming)
 
 
@@ -288,6 +315,7 @@ class TimingFile(Schema):
     rest_s: float
     motion: dict[str, MotionTimingTable]  # type: ignore[valid-type]
     hand_move: HandMoveTable | None = None
+    hand_stretch: HandStretchTable | None = None
 
 
 class PlanTable(Schema):
@@ -400,7 +428,20 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
         if base_s < 0 or speed <= 0:
             raise ConfigError(f"{where}: hand_move needs base_s >= 0 and speed_m_s > 0")
         moves = hand_moves(base_s, speed)
-    return Timing(60.0 / f.reference_bpm, f.rest_s, kinds, moves)
+    timing = Timing(60.0 / f.reference_bpm, f.rest_s, kinds, moves)
+    if (st := f.hand_stretch) is not None:
+        if st.min_interval_s < 0 or st.base_s < 0 or st.speed_m_s <= 0 or st.penalty < 0:
+            raise ConfigError(
+                f"{where}: hand_stretch needs min_interval_s >= 0, base_s >= 0, "
+                "speed_m_s > 0 and penalty >= 0"
+            )
+        timing = dataclasses.replace(
+            timing,
+            stretch_interval_s=st.min_interval_s,
+            stretch_moves=hand_moves(st.base_s, st.speed_m_s),
+            stretch_penalty=st.penalty,
+        )
+    return timing
 
 
 def default_config() -> PlanConfig:

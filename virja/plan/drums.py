@@ -38,6 +38,7 @@ class Stroke:
     piece: str
     priority: int
     dt: float = 0.0  # its note's time after the group's time (within the grouping window)
+    foot: bool = False  # a hi-hat stroke the left foot can take (a chick on the pedal)
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,27 @@ def drop_penalty(costs: DrumCosts, stroke: Stroke) -> float:
     return costs.drop_penalty + (9 - min(stroke.priority, 9))
 
 
+def unplayed_penalty(
+    costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...], assign: Assignment, i: int
+) -> float:
+    """What leaving stroke ``i`` to no hand of its own costs: a flam or drag (two strokes
+    of one piece) played by one hand, the second note on the stroke's rebound, is that
+    hand at a stretch (``stretch_penalty``, when the timing has a stretch), and so is
+    a hi-hat stroke the left foot takes (``Stroke.foot``); any other stroke is
+    dropped (:func:`drop_penalty`)."""
+    if timing.stretch_interval_s is not None:
+        if strokes[i].foot:
+            return timing.stretch_penalty
+        other = 1 - i
+        if (
+            len(strokes) == 2
+            and assign[other] is not None
+            and strokes[other].piece == strokes[i].piece
+        ):
+            return timing.stretch_penalty
+    return drop_penalty(costs, strokes[i])
+
+
 def transition(
     costs: DrumCosts, timing: Timing, state: HandState, group: HandGroup, assign: Assignment
 ) -> tuple[float, HandState, tuple[float, ...]] | None:
@@ -89,19 +111,25 @@ def transition(
     """
     prev, prev_t, t_right, t_left, p_right, p_left = state
     t = group.time
+    stretch = 0.0
     for stroke, hand in zip(group.strokes, assign, strict=True):
         if hand is None:
             continue
         last, lp = (t_right, p_right) if hand == RIGHT else (t_left, p_left)
-        if last is not None and t + stroke.dt - last < timing.gap(lp, stroke.piece) - TIME_EPS_S:
+        if last is None:
+            continue
+        since = t + stroke.dt - last
+        if since < timing.stretch_gap(lp, stroke.piece) - TIME_EPS_S:
             return None
+        if since < timing.gap(lp, stroke.piece) - TIME_EPS_S:
+            stretch += timing.stretch_penalty
     row = prev if prev is not None and prev_t is not None and t - prev_t < timing.rest_s else None
     order = sorted(
         (i for i, h in enumerate(assign) if h is not None),
         key=lambda i: 0 if assign[i] == LEFT else 1,
     )
     per = [0.0] * len(assign)
-    total = 0.0
+    total = stretch
     for i in order:
         hand = assign[i]
         assert hand is not None
@@ -114,9 +142,9 @@ def transition(
             t_right, p_right = t + group.strokes[i].dt, group.strokes[i].piece
         else:
             t_left, p_left = t + group.strokes[i].dt, group.strokes[i].piece
-    for stroke, hand in zip(group.strokes, assign, strict=True):
+    for i, hand in enumerate(assign):
         if hand is None:
-            total += drop_penalty(costs, stroke)
+            total += unplayed_penalty(costs, timing, group.strokes, assign, i)
     if order:
         prev, prev_t = row, t
     return total, (prev, prev_t, t_right, t_left, p_right, p_left), tuple(per)
@@ -157,21 +185,37 @@ class _Option:
 
 # A played option flattened for the solver's inner loop: (option index, the right
 # hand's piece and its stroke's dt (None, 0.0 when the right hand does not play), the
-# least time the right hand needs since its last stroke, by the piece it struck
-# (:meth:`Timing.gap` less TIME_EPS_S; -inf for every piece when it does not play),
-# the same three for the left hand, motion that ends the group (the next row),
-# penalty, first played motion, table cost first -> second played motion (0.0 for
-# one stroke)).
+# least time the right hand needs since its last stroke, by the piece it struck, at a
+# stretch and without (:meth:`Timing.stretch_gap` and :meth:`Timing.gap` less
+# TIME_EPS_S; -inf for every piece when it does not play), the same four for the left
+# hand, motion that ends the group (the next row), penalty, first played motion,
+# table cost first -> second played motion (0.0 for one stroke)).
 _Need = dict[str | None, float]
-_Played = tuple[int, str | None, float, _Need, str | None, float, _Need, int, float, int, float]
+_Played = tuple[
+    int,
+    str | None,
+    float,
+    _Need,
+    _Need,
+    str | None,
+    float,
+    _Need,
+    _Need,
+    int,
+    float,
+    int,
+    float,
+]
 
 
-def _needs(timing: Timing, piece: str | None) -> _Need:
-    """``Timing.gap(prev, piece) - TIME_EPS_S`` for every previous piece of a hand (none
-    included): the same floats :func:`transition` compares with, looked up once."""
+def _needs(timing: Timing, piece: str | None, *, stretch: bool) -> _Need:
+    """``Timing.gap(prev, piece) - TIME_EPS_S`` (``stretch``: ``stretch_gap``) for every
+    previous piece of a hand (none included): the same floats :func:`transition`
+    compares with, looked up once."""
     if piece is None:
         return dict.fromkeys((None, *HAND_PIECES), -math.inf)
-    return {prev: timing.gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
+    gap = timing.stretch_gap if stretch else timing.gap
+    return {prev: gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
 
 
 @dataclass(frozen=True, slots=True)
@@ -192,7 +236,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
         penalty = 0.0
         for i, (stroke, hand) in enumerate(zip(strokes, assign, strict=True)):
             if hand is None:
-                penalty += drop_penalty(costs, stroke)
+                penalty += unplayed_penalty(costs, timing, strokes, assign, i)
             else:
                 played.append(
                     (hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, stroke.dt, i)
@@ -209,10 +253,12 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     k,
                     r_piece,
                     r_dt,
-                    _needs(timing, r_piece),
+                    _needs(timing, r_piece, stretch=False),
+                    _needs(timing, r_piece, stretch=True),
                     l_piece,
                     l_dt,
-                    _needs(timing, l_piece),
+                    _needs(timing, l_piece, stretch=False),
+                    _needs(timing, l_piece, stretch=True),
                     last,
                     penalty,
                     first,
@@ -299,6 +345,7 @@ def solve(
     least objective, in their order; no effect on a layer that is not larger.
     """
     max_interval = timing.max_gap
+    stretch_pen = timing.stretch_penalty
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
@@ -353,17 +400,26 @@ def solve(
                     r_piece,
                     r_dt,
                     r_need,
+                    r_reach,
                     l_piece,
                     l_dt,
                     l_need,
+                    l_reach,
                     last,
                     penalty,
                     first,
                     pair,
                 ) in played_opts:
                     # a hand that does not play needs -inf: never infeasible
-                    if since_r + r_dt < r_need[p_right] or since_l + l_dt < l_need[p_left]:
+                    r_since, l_since = since_r + r_dt, since_l + l_dt
+                    if r_since < r_reach[p_right] or l_since < l_reach[p_left]:
                         continue
+                    if r_since < r_need[p_right]:  # at a stretch (stretch_penalty)
+                        penalty = penalty + stretch_pen
+                        if l_since < l_need[p_left]:
+                            penalty = penalty + stretch_pen
+                    elif l_since < l_need[p_left]:
+                        penalty = penalty + stretch_pen
                     nr, npr = keep_r, keep_pr
                     if r_piece is not None:
                         nr = None if t - (t + r_dt) >= max_interval else t + r_dt

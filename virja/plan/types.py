@@ -132,7 +132,9 @@ class PlannedNote:
 
 
 DropReason = Literal[
-    "too_many_hands",  # more simultaneous hand pieces than hands (priority kept the others)
+    # three or more hand pieces within the grouping window (30 ms), the hi-hat not to the
+    # foot: beyond two hands (an electronic kit's pad cross-talk); priority kept the others
+    "three_pieces_at_once",
     "too_fast",  # the limb cannot strike again so soon (minimum inter-stroke time)
     "no_free_limb",  # came after later notes of its limbs were fixed, and no limb was free then
     "unmapped",  # a drum note outside the kit map

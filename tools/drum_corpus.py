@@ -5,8 +5,9 @@ Usage:  .venv/bin/python tools/drum_corpus.py ../shared/data/gmd [--lookahead-be
 
 Each file goes through the same planner as `virja plan FILE` (notes read
 --lookahead-beats ahead).  Prints per reason the dropped drum notes over the
-whole corpus, the notes no kit drummer plays (routed to nobody), late notes,
-and the files with the most drops (--show N).  Exit status 1 when any kit note
+whole corpus and per pitch (with the kit map's name and piece), the notes no
+kit drummer plays (routed to nobody), late notes, and the files with the most
+drops (--show N).  Exit status 1 when any kit note
 was dropped for a reason other than three_pieces_at_once (three or more hand pieces
 within the grouping window, which no two hands can play).
 """
@@ -25,9 +26,10 @@ from virja.pipeline import PerformanceSettings, perform
 ALLOWED = {"three_pieces_at_once"}
 
 
-def plan_file(
-    path: str, lookahead: float = 1.0
-) -> tuple[str, Counter[str], Counter[str], int, int]:
+Result = tuple[str, Counter[str], Counter[str], int, int, Counter[tuple[int, str]]]
+
+
+def plan_file(path: str, lookahead: float = 1.0) -> Result:
     # planned as `virja plan` and render plan it (virja.pipeline.perform)
     settings = PerformanceSettings()
     perf, planned = perform(settings, midi_input(Path(path), settings.routing, lookahead))
@@ -36,11 +38,31 @@ def plan_file(
     nobody = Counter(dict(report.unplayed))
     late = sum(1 for p in planned if p.performer == "drums" and p.late)
     n = perf.counts["notes_drums"]
-    return path, drops, nobody, late, n
+    by_pitch: Counter[tuple[int, str]] = Counter(
+        (d.note.note, d.reason) for d in report.dropped if d.performer == "drums"
+    )
+    return path, drops, nobody, late, n, by_pitch
 
 
-def _run(args: tuple[str, float]) -> tuple[str, Counter[str], Counter[str], int, int]:
+def _run(args: tuple[str, float]) -> Result:
     return plan_file(*args)
+
+
+def _pitch_lines(by_pitch: Counter[tuple[int, str]]) -> list[str]:
+    """One line per dropped pitch, most drops first: the kit map's name and piece."""
+    from virja.plan.config import default_config
+
+    kit = default_config().kit
+    pitches: Counter[int] = Counter()
+    for (pitch, _reason), n in by_pitch.items():
+        pitches[pitch] += n
+    lines = []
+    for pitch, n in pitches.most_common():
+        dn = kit.lookup(pitch)
+        name = "unmapped" if dn is None else f"{dn.name}, {dn.piece}"
+        reasons = ", ".join(f"{r} {k}" for (p, r), k in sorted(by_pitch.items()) if p == pitch)
+        lines.append(f"  pitch {pitch:3d} ({name}): {n}; {reasons}")
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -65,8 +87,10 @@ def main(argv: list[str] | None = None) -> int:
             results = list(ex.map(_run, work, chunksize=8))
     else:
         results = [_run(w) for w in work]
-    for path, d, nb, lt, n in results:
+    by_pitch: Counter[tuple[int, str]] = Counter()
+    for path, d, nb, lt, n, bp in results:
         drops += d
+        by_pitch += bp
         nobody += nb
         late += lt
         total += n
@@ -78,6 +102,9 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"dropped: {sum(drops.values())}" + "".join(f"; {r}: {n}" for r, n in sorted(drops.items()))
     )
+    if by_pitch:
+        print("dropped by pitch:")
+        print("\n".join(_pitch_lines(by_pitch)))
     print(
         f"played by nobody (not a kit instrument): {sum(nobody.values())}"
         + "".join(f"; {k}: {n}" for k, n in sorted(nobody.items()))

@@ -29,7 +29,7 @@ from virja.cli.common import (
 )
 from virja.errors import ConfigError
 from virja.input import PerformanceInput, nothing_for_the_band
-from virja.plan.types import PlannedNote, PlanReport
+from virja.plan.types import DROP_REASON_TEXT, PlannedNote, PlanReport
 from virja.vocab import PERFORMERS
 
 PCAP_SUFFIXES = {".pcap", ".pcapng", ".cap"}
@@ -111,7 +111,10 @@ def _summary(planned: list[PlannedNote], report: PlanReport, origin_s: float = 0
     drops = Counter((d.performer, d.reason) for d in report.dropped)
     lines.append(
         f"dropped: {len(report.dropped)}"
-        + "".join(f"; {who} {reason}: {n}" for (who, reason), n in sorted(drops.items()))
+        + "".join(
+            f"; {who} {reason}: {n} ({DROP_REASON_TEXT.get(reason, reason)})"
+            for (who, reason), n in sorted(drops.items())
+        )
     )
     if report.unplayed:
         lines.append(

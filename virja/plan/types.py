@@ -143,6 +143,20 @@ DropReason = Literal[
     "planner_full",  # its limbs already had the most notes a plan may wait on (plan.bounds)
 ]
 
+# what each reason means, for a reader of `virja plan`'s summary
+DROP_REASON_TEXT: dict[str, str] = {
+    "three_pieces_at_once": (
+        "three or more hand pieces within 30 ms: beyond two hands, as an electronic "
+        "kit's pad cross-talk makes"
+    ),
+    "too_fast": "no limb can strike again so soon, even at a stretch",
+    "no_free_limb": "arrived after its limbs' later notes were fixed",
+    "unmapped": "not in the kit map",
+    "no_double_stop": "cannot be stopped with the melody note",
+    "too_dense": "more notes around its time than anyone plays",
+    "planner_full": "the plan already held the most notes it may wait on",
+}
+
 
 @dataclass(frozen=True)
 class DroppedNote:

@@ -231,14 +231,19 @@ def solve(
         gap = math.inf if gaps is None else gaps[gi]
         # :func:`transitions` inlined, with what does not depend on the previous state
         # worked out once per group (same arithmetic, same order, same results)
-        prepared: list[tuple[Position | None, int, int, int, tuple[int, ...]]] = []
+        # per option: its anchor, melody string, stopped frets, and per hand position
+        # the position, the state it leads to and its position cost
+        prepared: list[
+            tuple[Position | None, int, int, int, list[tuple[int, HandState, float]]]
+        ] = []
         for opt in options:
             a = anchor(opt)
             if a is None:
-                prepared.append((a, opt[0][0], 0, 0, ()))
+                prepared.append((a, opt[0][0], 0, 0, []))
                 continue
             low, high = _stops(opt) or (a[1], a[1])
-            prepared.append((a, opt[0][0], low, high, hand_positions(fingering, low, high)))
+            hs = [(h, (a[0], a[1], h), per * (h - 1)) for h in hand_positions(fingering, low, high)]
+            prepared.append((a, opt[0][0], low, high, hs))
         nxt: dict[BassState, float] = {}
         back: dict[BassState, tuple[BassState, int, float]] = {}
         for prev, acc in best.items():
@@ -247,7 +252,7 @@ def solve(
                 if a is None:
                     moves = [(0.0 if prev is None else float(abs(melody - prev[0])), prev)]
                 elif prev is None:
-                    moves = [(per * (h - 1), (a[0], a[1], h)) for h in hs]
+                    moves = [(ph, state) for _h, state, ph in hs]
                 else:
                     s0, f0, h0 = prev
                     base = float(abs(a[1] - f0) + abs(a[0] - s0))
@@ -255,12 +260,12 @@ def solve(
                         moves = [(base + per * (h0 - 1), (a[0], a[1], h0))]
                     else:
                         moves = []
-                        for h in hs:
+                        for h, state, ph in hs:
                             d = abs(h - h0)
-                            c = base + shift_cost + shift_per_fret * d + per * (h - 1)
+                            c = base + shift_cost + shift_per_fret * d + ph
                             if gap < shift_times[d]:
                                 c += rushed
-                            moves.append((c, (a[0], a[1], h)))
+                            moves.append((c, state))
                 for c, new in moves:
                     total = acc + c
                     old = nxt.get(new)

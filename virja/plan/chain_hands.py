@@ -91,11 +91,16 @@ def hand_group(
         else:
             same.append(r)
 
-    def rank(c: list[DrumHeld]) -> tuple[int, float, int]:
-        prio = min(velocity_priority(r.drum.priority, r.note.velocity) for r in c)
-        return (prio, c[0].note.time_s, c[0].seq)
-
-    ranked = sorted(clusters, key=rank)
+    ranks = [
+        (
+            min(velocity_priority(r.drum.priority, r.note.velocity) for r in c),
+            c[0].note.time_s,
+            c[0].seq,
+        )
+        for c in clusters
+    ]
+    prio = {c[0].seq: rk[0] for c, rk in zip(clusters, ranks, strict=True)}
+    ranked = [c for _rk, c in sorted(zip(ranks, clusters, strict=True), key=lambda x: x[0])]
     # the hands go to two pieces where there are two (a further stroke on one of them
     # is that hand's double), to a flam or drag on one piece where there is one
     other = next((c for c in ranked[1:] if c[0].drum.piece != ranked[0][0].drum.piece), None)
@@ -118,7 +123,7 @@ def hand_group(
     strokes = tuple(
         drums_mod.Stroke(
             c[0].drum.piece,
-            rank(c)[0],
+            prio[c[0].seq],
             c[0].note.time_s - t0,
             chick is not None and c[0].drum.piece == "hihat" and chick(c[0].note.time_s),
         )
@@ -203,10 +208,15 @@ class HandsChain(DrumChain):
             self._decide_foot(g, rebounds)
         aside = rebounds | {r.seq for r in self.pending if r.to_foot}
 
+        prepared: dict[int, HandGroupPlan] = {}  # by the group's first note, made once
+
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
-            return hand_group(
-                [r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick
-            )
+            hp = prepared.get(g[0].seq)
+            if hp is None:
+                hp = prepared[g[0].seq] = hand_group(
+                    [r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick
+                )
+            return hp
 
         def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
             sol = drums_mod.solve(

@@ -8,8 +8,17 @@ own time, by the limb the rule names.
 
 from __future__ import annotations
 
+import importlib.util
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
 from virja.cli.cmd_plan import _summary
 from virja.events import NoteOn
+from virja.input import midi_input
+from virja.pipeline import PerformanceSettings, perform
 from virja.plan import PlannedNote, PlanReport, plan_notes_with_report
 from virja.plan.types import DroppedNote
 from virja.tempo import ConstantTempo
@@ -91,3 +100,37 @@ def test_plan_names_what_the_impossibility_is() -> None:
     lines = _summary([], PlanReport(dropped=(drop,)))
     line = next(x for x in lines if x.startswith("dropped"))
     assert "drums three_pieces_at_once: 1 (three or more hand pieces within 30 ms" in line
+
+
+DEMOS = sorted((Path(__file__).parents[2] / "virja" / "demo").glob("*.mid"))
+
+
+@pytest.mark.parametrize("path", DEMOS, ids=[p.stem for p in DEMOS])
+def test_the_demos_drop_no_kit_note_and_none_is_late(path: Path) -> None:
+    """The bundled MMA sessions, read a beat ahead as `virja plan` reads them."""
+    settings = PerformanceSettings()
+    perf, planned = perform(settings, midi_input(path, settings.routing, 1.0))
+    assert [d for d in perf.planner.report.dropped if d.performer == "drums"] == []
+    assert not any(p.late for p in planned if p.performer == "drums")
+
+
+@pytest.mark.skipif(shutil.which("mma") is None, reason="MMA (Debian package mma) not installed")
+def test_generated_fast_swing_at_300_bpm_drops_no_kit_note(tmp_path: Path) -> None:
+    """MMA's FastSwing at 300 bpm (tools/mma_jazz.py's song): 8 notes dropped as
+    too_fast before the hand's stretch."""
+    spec = importlib.util.spec_from_file_location(
+        "mma_jazz", Path(__file__).parents[2] / "tools" / "mma_jazz.py"
+    )
+    assert spec is not None and spec.loader is not None
+    mma_jazz = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mma_jazz)
+    src = tmp_path / "fast.mma"
+    src.write_text(mma_jazz.song("FastSwing", 300))
+    out = tmp_path / "fast.mid"
+    subprocess.run(["mma", str(src), "-f", str(out)], check=True, capture_output=True)
+    settings = PerformanceSettings()
+    perf, planned = perform(settings, midi_input(out, settings.routing, 1.0))
+    drums = [p for p in planned if p.performer == "drums"]
+    assert len(drums) > 100
+    assert [d for d in perf.planner.report.dropped if d.performer == "drums"] == []
+    assert not any(p.late for p in drums)

@@ -4,8 +4,9 @@
 Its state is the time of its last stroke.  A group is one stroke (notes within
 HAND_WINDOW_S of its first; the later ones are the beater's or the cymbals'
 bounce); a stroke sooner than the foot can strike again (``min_interval_s``) is
-the second note of a double from one press, played by the stroke's rebound.  The left foot also takes the hi-hat notes the hands
-give it (:meth:`FootChain.chick`).  Shared rules: :mod:`virja.plan.chain`,
+the second note of a double from one press, played by the stroke's rebound.
+The left foot also takes the hi-hat notes the hands give it
+(:meth:`FootChain.chick`).  Shared rules: :mod:`virja.plan.chain`,
 :mod:`virja.plan.chain_kit`.
 """
 

@@ -8,10 +8,13 @@ previous one (docs/scheduler.md).  Constraints: one hand strikes one piece at
 a time; the two strokes of a group (notes within the grouping window) go to
 different hands; a hand strikes again only after :meth:`Timing.gap` from its
 last stroke: the piece's ``min_interval_s`` on the same piece (rebound doubles,
-taps, buzz), longer the farther it has to travel to another piece.  A stroke that
-no hand can make in time is dropped at a penalty (``drop_penalty`` + 9 -
-priority), so dropping happens only when nothing else is feasible.  Ties go to
-the right hand (the time-keeping hand keeps the time).
+taps, buzz), longer the farther it has to travel to another piece; at a stretch
+(:meth:`Timing.stretch_gap`: a pressed double, a snap of the wrist) sooner, for
+``stretch_penalty`` a stroke, as is a flam by one hand or a hi-hat stroke left to
+the foot (:func:`unplayed_penalty`).  A stroke that no hand can make in time is
+dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
+when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
+keeps the time).
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """

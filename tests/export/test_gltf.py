@@ -212,3 +212,43 @@ def test_a_five_string_bass_exports_its_five_strings_all_vibrating(tmp_path: Pat
     }
     assert vibrating == set(strings)
     assert not _errors(validate(out))
+
+
+def _positions(doc: pygltflib.GLTF2, mesh: int) -> np.ndarray:
+    """The POSITION vertices (k, 3) of a mesh's first primitive, from the GLB's blob."""
+    acc = doc.accessors[doc.meshes[mesh].primitives[0].attributes.POSITION]
+    view = doc.bufferViews[acc.bufferView]
+    start = (view.byteOffset or 0) + (acc.byteOffset or 0)
+    blob = doc.binary_blob()
+    return np.frombuffer(blob[start : start + acc.count * 12], dtype=np.float32).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("tuning", ["four", "five", "six"])
+def test_the_fingerboard_is_as_wide_as_the_tunings_strings(tmp_path: Path, tuning: str) -> None:
+    """The exported fingerboard tapers with the tuning's strings: every string's ends on it
+    (nut, and where the board ends) lie 5 mm or more inside its edges, in the bass's own
+    frame (the board's parent leans it), and the file stays valid."""
+    from tests.conftest import DEMO_MID
+    from virja.fingerboard import fingerboard
+    from virja.vocab import ALL_BASS_STRINGS
+
+    config = tmp_path / f"{tuning}.toml"
+    config.write_text(f'[plan]\nbass_tuning = "{tuning}"\n')
+    out = tmp_path / f"{tuning}.glb"
+    export_performance(DEMO_MID, gltf=out, config=config, end_s=2.0)
+    doc = pygltflib.GLTF2().load(str(out))
+    node = next(n for n in doc.nodes if n.name == "bass_fingerboard")
+    assert node.translation is None and node.rotation is None and node.matrix is None
+    strings = {"four": "EADG", "five": "BEADG", "six": "BEADGC"}[tuning]
+    b = GEOMETRY.bass
+    board = fingerboard(b, tuple(ALL_BASS_STRINGS))  # its frame (the same for every tuning)
+    c = board.coords(_positions(doc, node.mesh).astype(np.float64))
+    ends = (c[:, 0] < 1e-4, c[:, 0] > board.length - 1e-4)  # the nut's and the end's corners
+    for s in strings:
+        d = b.string_dir(s)
+        nut = board.coords(b.nut[s])
+        end = board.coords(b.nut[s] + d * (board.length - nut[0]) / (d @ board.along))
+        for at, p in zip(ends, (nut, end), strict=True):
+            lat = c[at, 1]
+            assert lat.min() + 0.005 <= p[1] <= lat.max() - 0.005, (s, p, lat)
+    assert not _errors(validate(out))

@@ -6,6 +6,7 @@ note-offs; and the note table follows notes added, ended and forgotten."""
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -26,7 +27,6 @@ from virja.motion.bassist import (
     _HANDS,
     _LTIP,
     _SHOULDERS,
-    BOARD_HALF_WIDTH_M,
     CHEST,
     POLE_PUSH_MAX_M,
     POLE_PUSH_PER_M,
@@ -70,19 +70,26 @@ def _plain_torso(loc: np.ndarray, sway: float, dip: float, turn: float) -> np.nd
 
 def _plain_wrist_beside_board(
     b: Bassist, wrist: np.ndarray, tip: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, float]:
+    s = b.settings
     n = b.neck
     rel = wrist - tip
     length = float(np.linalg.norm(rel))
-    need = BOARD_HALF_WIDTH_M + WRIST_BESIDE_M
+    c_tip = n.coords(tip)
+    need = float(n.low_edge(float(c_tip[0]))) + WRIST_BESIDE_M
     if float(n.coords(wrist)[1]) >= need or length < 1e-9:
-        return wrist, quat.identity()
-    d_lat = min(need - float(n.coords(tip)[1]), length)
-    other = rel - (rel @ n.lateral) * n.lateral
-    norm = float(np.linalg.norm(other))
-    other = other / norm if norm > 1e-9 else n.face
-    new = d_lat * n.lateral + math.sqrt(max(length**2 - d_lat**2, 0.0)) * other
-    return tip + new, quat.from_two_vectors(rel, new)
+        return wrist, quat.identity(), 0.0
+    d_need = need - float(c_tip[1])
+    d_lat = min(d_need, s.reach_share * length)
+    ramp = min(max((d_need - d_lat) / s.arch_ramp_m, 0.0), 1.0)
+    r = math.sqrt(max(length**2 - d_lat**2, 0.0))
+    along, face = float(rel @ n.along), float(rel @ n.face)
+    norm = math.hypot(along, face)
+    f0, a0 = (face / norm, along / norm) if norm > 1e-9 else (1.0, 0.0)
+    f = max(r * f0, -r + (min(s.arch_m, r) + r) * ramp)
+    a = math.copysign(math.sqrt(max(r**2 - f**2, 0.0)), 1.0 if a0 >= 0.0 else -1.0)
+    new = d_lat * n.lateral + a * n.along + f * n.face
+    return tip + new, quat.from_two_vectors(rel, new), ramp
 
 
 def _plain_reach_with_shoulder(
@@ -114,11 +121,16 @@ def plain_body(
     last = b.current(t)
     if last is None:
         return loc
-    settle = min(max(3.0 - (t - last.impact), 0.0), 1.0)
-    loud = (0.6 + 0.4 * last.velocity / 127) * settle
+    i = bisect.bisect_right(b._times, t) - 1
+    ramp = s.body_ramp_s
+    after = min(max(3.0 - (t - last.impact), 0.0), 1.0)
+    nxt = b._notes[i + 1].impact if i + 1 < len(b._notes) else math.inf
+    before = min(max(1.0 + (t - nxt) / ramp, 0.0), 1.0)
+    first = min(max((t - b._notes[0].impact) / ramp, 0.0), 1.0)
+    loud = (0.6 + 0.4 * last.velocity / 127) * max(after, before) * first
     two = (beat_index % 2 + beat_phase) / 2.0
-    sway = s.sway_rad * loud * math.sin(2 * math.pi * two)
-    dip = s.dip_rad * loud * math.sin(math.pi * beat_phase) ** 2
+    sway = s.sway_rad * loud * math.cos(2 * math.pi * two)
+    dip = s.dip_rad * loud * (0.5 + 0.5 * math.cos(2 * math.pi * (beat_phase - s.dip_after_beat)))
     # the chest turns with where the fingertip is along the neck while a stopped note is held
     down = 0.0
     if held is not None:
@@ -126,7 +138,7 @@ def plain_body(
     turn = s.turn_rad_per_m * down
     targets = wpos[_HANDS].copy()
     hand_rot = wrot[_HANDS].copy()
-    targets[0], turn_hand = _plain_wrist_beside_board(b, wpos[_HANDS[0]], wpos[_LTIP])
+    targets[0], turn_hand, arched = _plain_wrist_beside_board(b, wpos[_HANDS[0]], wpos[_LTIP])
     hand_rot[0] = quat.multiply(turn_hand, hand_rot[0])
     targets[0] += _plain_vibrato(b, t)
     endpin = b.geometry.bass.endpin
@@ -160,6 +172,7 @@ def plain_body(
     across = -float(b.neck.coords(wpos[_LTIP])[1])
     push = min(max(across, 0.0) * POLE_PUSH_PER_M, POLE_PUSH_MAX_M)
     poles[0] += push * quat.rotate(q, b.neck.lateral)
+    poles[0] += arched * s.arch_elbow_m * quat.rotate(q, b.neck.face)
     upper, lower = _two_bone(moved_pos[_ARMS], leaned, poles)
     out[_ARMS] = quat.multiply(quat.conjugate(moved_rot[_SHOULDERS]), upper)
     out[_FORES] = quat.multiply(quat.conjugate(upper), lower)
@@ -216,6 +229,17 @@ def test_batched_body_with_note_offs_vibrato_and_forgetting(library: MotionLibra
     a.add_planned(bass("D", 2, 12.3, 12.5))
     _compare(a, np.arange(12.0, 14.0, 1 / 30))
     assert a.bassist._note_table().impact.tolist() == [n.impact for n in a.bassist._notes]
+
+
+def test_batched_body_on_a_six_string_high_up(library: MotionLibrary) -> None:
+    """The high C and G up the neck of a six-string: the hand arched over the wide board
+    (its wrist in front of the strings, the elbow's pole raised) in both versions."""
+    a = BandAnimator(library)
+    a.use_bass_strings(("B", "E", "A", "D", "G", "C"))
+    frets = [("C", 12), ("C", 17), ("G", 15), ("C", 20), ("B", 3), ("C", 9)]
+    for i, (string, fret) in enumerate(frets):
+        a.add_planned(bass(string, fret, 0.6 * i + 0.3, 0.6 * i + 0.5))
+    _compare(a, np.arange(0.0, 5.0, 1 / 30))
 
 
 @pytest.mark.parametrize("fret", [0, 5])

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from virja import quat
+from virja.fingerboard import fingerboard
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
 from virja.vocab import BASS_STRINGS
@@ -161,6 +162,29 @@ def _box() -> tuple[F64, F64, NDArray[np.uint16]]:
             for su, sw in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
                 pos.append(0.5 * (n + su * u + sw * w))
                 nrm.append(n)
+            idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+    return np.array(pos), np.array(nrm), np.array(idx, dtype=np.uint16)
+
+
+def _hexahedron(corners: F64) -> tuple[F64, F64, NDArray[np.uint16]]:
+    """A six-sided solid with flat faces from its 8 ``corners`` (bit i of a corner's index:
+    which end along axis i, as :meth:`virja.fingerboard.Fingerboard.corners` orders them)."""
+    pos: list[F64] = []
+    nrm: list[F64] = []
+    idx: list[int] = []
+    centre = corners.mean(axis=0)
+    for axis in range(3):
+        for side in (0, 1):
+            quad = [i for i in range(8) if (i >> (2 - axis)) & 1 == side]
+            a, b, c, d = (corners[i] for i in (quad[0], quad[1], quad[3], quad[2]))
+            n = np.cross(b - a, d - a)
+            n /= np.linalg.norm(n)
+            if np.dot(n, a - centre) < 0:  # outward, counter-clockwise seen from outside
+                n = -n
+                a, b, c, d = a, d, c, b
+            base = len(pos)
+            pos += [a, b, c, d]
+            nrm += [n] * 4
             idx += [base, base + 1, base + 2, base, base + 2, base + 3]
     return np.array(pos), np.array(nrm), np.array(idx, dtype=np.uint16)
 
@@ -305,6 +329,15 @@ class GltfBuilder:
             )
             self._meshes[key] = len(self.doc["meshes"]) - 1
         return self._meshes[key]
+
+    def custom_mesh(
+        self, name: str, pos: F64, nrm: F64, idx: NDArray[np.uint16], colour: str
+    ) -> int:
+        """A mesh of its own (``pos``, ``nrm`` (k, 3), triangle ``idx``) in ``colour``."""
+        self.doc["meshes"].append(
+            {"name": name, "primitives": [self._primitive(pos, nrm, idx, colour)]}
+        )
+        return len(self.doc["meshes"]) - 1
 
     def string_mesh(self, name: str) -> int:
         pos, nrm, idx, target = _string_mesh()
@@ -661,23 +694,28 @@ def _upright_bass(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _
         "wood",
     )
     b.ball("bass_scroll", node, nut_c + 0.10 * up - 0.02 * bb.front, 0.05, "wood")
-    fb_end = nut_c + 0.78 * (bridge_c - nut_c)
-    length = float(np.linalg.norm(fb_end - nut_c))
+    # the strings of the tuning the performance was planned on (string_vibration's keys)
+    tuning = [n for n in bb.strings if n in s.string_vibration] or list(BASS_STRINGS)
+    # the fingerboard tapers with the tuning's strings (virja.fingerboard): its own mesh
+    board = fingerboard(bb, tuple(tuning))
+    pos, nrm, idx = _hexahedron(board.corners())
+    b.node("bass_fingerboard", node, mesh=b.custom_mesh("bass_fingerboard", pos, nrm, idx, "ebony"))
+    lat = [
+        float((bb.bridge[n] - bridge_c) @ quat.rotate(o, np.array([1.0, 0.0, 0.0]))) for n in tuning
+    ]
+    bridge_w = max(0.13, max(lat) - min(lat) + 0.02)  # as wide as its strings need
     b.box(
-        "bass_fingerboard",
+        "bass_bridge",
         node,
-        (nut_c + fb_end) / 2 - 0.008 * bb.front,
-        np.array([0.07, length, 0.014]),
+        bridge_c - 0.02 * bb.front,
+        np.array([bridge_w, 0.08, 0.012]),
         o,
-        "ebony",
+        "wood",
     )
-    b.box("bass_bridge", node, bridge_c - 0.02 * bb.front, np.array([0.13, 0.08, 0.012]), o, "wood")
     b.box("bass_tailpiece", node, bridge_c - 0.20 * up, np.array([0.09, 0.22, 0.012]), o, "ebony")
     b.segment("bass_endpin", node, bb.endpin, bb.endpin + 0.2 * up, 0.008, "chrome")
     lateral = np.cross(bb.axis, bb.front)
     lateral /= np.linalg.norm(lateral)
-    # the strings of the tuning the performance was planned on (string_vibration's keys)
-    tuning = [n for n in bb.strings if n in s.string_vibration] or list(BASS_STRINGS)
     for k, name in enumerate(bb.strings):
         if name not in tuning:
             continue

@@ -190,6 +190,7 @@ class BandAnimator:
                 f"got {' '.join(strings) or 'none'}"
             )
         self.bass_strings = tuple(strings)
+        self.bassist.use_strings(self.bass_strings)
 
     # ------------------------------------------------------------------ input
 

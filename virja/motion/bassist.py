@@ -14,7 +14,8 @@ impact; this module adds what the clips do not carry:
   right hand plucks with index and middle finger alternating, the other one
   resting beside it.
 - **Living body** (:meth:`Bassist.body`): weight shifting from foot to foot
-  over two beats, the spine dipping on each beat, the chest turning toward the
+  over two beats (on one foot at each beat, so a note on the beat shows the
+  lean), the spine dipping deepest just after each beat, the chest turning toward the
   fretting hand as it moves down the neck; larger for louder notes.  The arms
   are solved again afterwards (:func:`virja.motion.ik.two_bone`) so both hands
   stay exactly where the clips put them: contact and timing do not change.
@@ -36,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from virja import quat
+from virja.fingerboard import Fingerboard, fingerboard
 from virja.geometry import Geometry
 from virja.motion import bass_lean
 from virja.motion.skeleton import SKELETON
@@ -62,17 +64,23 @@ class BassistSettings:
     hover_m: float = 0.006  # fingers not stopping the string, above it
     lift_m: float = 0.014  # all fingers after the note-off or for an open string
     thumb_behind_m: float = 0.045  # thumb tip behind the strings
-    sway_rad: float = 0.03  # hips: weight from foot to foot over two beats
-    dip_rad: float = 0.035  # spine: forward on each beat
+    sway_rad: float = 0.03  # hips: weight from foot to foot over two beats, on a foot at a beat
+    dip_rad: float = 0.035  # spine: forward with each beat...
+    dip_after_beat: float = 0.12  # ...deepest this share of a beat after it
+    body_ramp_s: float = 0.4  # the body's motion grows over this before a note after a rest
     turn_rad_per_m: float = 0.25  # chest: toward the fretting hand, per metre down the neck
-    shoulder_slack_m: float = 0.48  # the fretting shoulder reaches toward a wrist farther...
-    shoulder_max_rad: float = 0.45  # ...than this, turning its collarbone at most this much
+    shoulder_slack_m: float = 0.42  # the fretting shoulder reaches toward a wrist farther...
+    shoulder_max_rad: float = 0.9  # ...than this, turning its collarbone at most this much
     thumb_position_fret: int = 12
     vibrato_m: float = 0.003  # left hand rolling along the string on a long note
     vibrato_hz: float = 5.0
     vibrato_after_s: float = 0.25  # it starts this long after the impact
     long_note_s: float = 0.45  # notes at least this long get vibrato
     lean_follow: float = 0.8  # the bass's contact point follows this much of the chest's move
+    reach_share: float = 0.8  # the fretting wrist beside the board: at most this much of the
+    arch_m: float = 0.05  # hand sideways; beyond, it rises this far in front of the strings
+    arch_ramp_m: float = 0.01  # as it stays this far over the board's low edge
+    arch_elbow_m: float = 0.8  # the arched hand's elbow pole raised this far toward the front
 
 
 @dataclass
@@ -95,62 +103,62 @@ _SHOULDERS = [_SK.index("LeftShoulder"), _SK.index("RightShoulder")]
 CHEST = _SK.index("Chest")
 _LTIP = _SK.index("LeftHandEnd")
 
-# the fingerboard as render.scene draws it (a 7 cm board, its face 4 mm behind the strings,
-# the neck 3 cm deep behind them)
-BOARD_HALF_WIDTH_M = 0.035
-BOARD_FACE_M = -0.004
-BOARD_BACK_M = -0.030
-WRIST_BESIDE_M = 0.005  # the fretting wrist beside the board's E edge, this far out
+# the fretting wrist beside the fingerboard's low (E, B) edge (virja.fingerboard), this far out
+WRIST_BESIDE_M = 0.005
 WRIST_OVER_MAX_M = 0.010  # at most this far over it, where the hand cannot reach round
+# a forearm this far in front of the strings or more passes over the board (arched over it,
+# as in thumb position), not across or through it
+CLEAR_OF_STRINGS_M = 0.02
 # the fretting elbow's pole pushed toward the E side as the fingertip goes toward the G
 # side (m of push per m the tip is past the board's centre line), up to POLE_PUSH_MAX_M
 POLE_PUSH_PER_M = 12.0
 POLE_PUSH_MAX_M = 0.6
 
-
-@dataclass(frozen=True)
-class NeckFrame:
-    """The fingerboard's frame in the bass's own frame: ``nut`` (3,) the centre of the
-    nut; ``along`` toward the bridge, ``lateral`` toward the E side, ``face`` out of the
-    board toward the strings (unit (3,)); ``length`` of the board (m)."""
-
-    nut: np.ndarray
-    along: np.ndarray
-    lateral: np.ndarray
-    face: np.ndarray
-    length: float
-
-    def coords(self, points: np.ndarray) -> np.ndarray:
-        """(..., 3) -> (..., 3) (along, lateral, face) of points, m from the nut's centre."""
-        rel = np.asarray(points, dtype=np.float64) - self.nut
-        return np.stack([rel @ self.along, rel @ self.lateral, rel @ self.face], axis=-1)
+NeckFrame = Fingerboard  # the board's frame and edges (the name the motion code used)
 
 
-def neck_frame(geometry: Geometry) -> NeckFrame:
-    """The fingerboard as render.scene draws it, along the middle four strings."""
-    b = geometry.bass
-    four = [s for s in b.strings if s in BASS_STRINGS]
-    nut = np.mean([b.nut[s] for s in four], axis=0)
-    bridge = np.mean([b.bridge[s] for s in four], axis=0)
-    along = bridge - nut
-    length = 0.78 * float(np.linalg.norm(along))  # the fingerboard ends 78 % of the way
-    along = along / np.linalg.norm(along)
-    face = b.front - np.dot(b.front, along) * along
-    face = face / np.linalg.norm(face)
-    return NeckFrame(nut, along, np.cross(face, along), face, length)
+def neck_frame(geometry: Geometry, strings: tuple[str, ...] = BASS_STRINGS) -> Fingerboard:
+    """The fingerboard as render.scene draws it for the tuning's ``strings``."""
+    return fingerboard(geometry.bass, tuple(strings))
 
 
-def forearm_over_board_m(neck: NeckFrame, elbow: np.ndarray, wrist: np.ndarray) -> np.ndarray:
+def forearm_over_board_m(neck: Fingerboard, elbow: np.ndarray, wrist: np.ndarray) -> np.ndarray:
     """How far (m, >= 0) the forearms (..., 3) elbow -> wrist reach over the fingerboard's
-    E edge in front of the neck's back (0: the forearm stays behind the neck or beside it);
+    low edge between the neck's back and ``CLEAR_OF_STRINGS_M`` in front of the strings
+    (0: the forearm stays behind the neck, beside it, or arched clear over the strings);
     a forearm through the neck counts its whole overlap."""
     u = np.linspace(0.0, 1.0, 17)[:, None]
     e = np.asarray(elbow, dtype=np.float64)[..., None, :]
     w = np.asarray(wrist, dtype=np.float64)[..., None, :]
     c = neck.coords(e + u * (w - e))  # (..., 17, 3)
-    by_board = (c[..., 0] > 0.0) & (c[..., 0] < neck.length) & (c[..., 2] > BOARD_BACK_M)
-    over = np.where(by_board, BOARD_HALF_WIDTH_M - c[..., 1], 0.0)
+    by_board = (
+        (c[..., 0] > 0.0)
+        & (c[..., 0] < neck.length)
+        & (c[..., 2] > neck.spec.back_m)
+        & (c[..., 2] < CLEAR_OF_STRINGS_M)
+    )
+    over = np.where(by_board, neck.low_edge(c[..., 0]) - c[..., 1], 0.0)
     return np.asarray(np.clip(over, 0.0, None).max(axis=-1))
+
+
+SIDE_OVER_M = 0.01  # a wrist beside the board: at most this far over its low edge...
+ARCHED_M = 0.02  # ...and less than this in front of the fingertip; or arched over the board
+
+
+def fretting_side(
+    neck: Fingerboard, elbow: np.ndarray, wrist: np.ndarray, tip: np.ndarray
+) -> np.ndarray:
+    """Whether the fretting hand (elbow, wrist, fingertip (..., 3)) is on the correct side:
+    its wrist toward the low side from the fingertip, and either beside the board (at most
+    ``SIDE_OVER_M`` over its low edge, less than ``ARCHED_M`` in front of the fingertip,
+    the elbow behind the strings) or arched over it (``ARCHED_M`` or more in front, as in
+    thumb position) with the elbow out beyond the board's low edge."""
+    e, w, t = neck.coords(elbow), neck.coords(wrist), neck.coords(tip)
+    front = w[..., 2] - t[..., 2]
+    beside = (w[..., 1] > neck.low_edge(w[..., 0]) - SIDE_OVER_M) & (front < ARCHED_M)
+    beside &= e[..., 2] < 0.0
+    arched = (front >= ARCHED_M) & (e[..., 1] > neck.low_edge(e[..., 0]))
+    return np.asarray((w[..., 1] > t[..., 1]) & (beside | arched))
 
 
 def _frames(direction: np.ndarray, hinge: np.ndarray) -> np.ndarray:
@@ -219,6 +227,11 @@ class Bassist:
         lateral = np.cross(b.axis, b.front)
         self._lateral = lateral / np.linalg.norm(lateral)  # toward the low strings
         self.neck = neck_frame(geometry)
+
+    def use_strings(self, strings: tuple[str, ...]) -> None:
+        """The tuning's strings: the fingerboard (and so where the fretting wrist goes
+        beside it) is as wide as they need."""
+        self.neck = neck_frame(self.geometry, strings)
 
     # -- input ------------------------------------------------------------------
 
@@ -427,19 +440,30 @@ class Bassist:
             return out
         t, i, loc = t[rows], i[rows], loc[rows]
         last = i - 1
-        # playing: full size; 2 s after the last note the body settles over a second
-        settle = np.clip(3.0 - (t - tab.impact[last]), 0.0, 1.0)
-        loud = (0.6 + 0.4 * tab.velocity[last] / 127) * settle
-        # weight from one foot to the other over two beats; a dip of the spine on each beat
+        loud = (0.6 + 0.4 * tab.velocity[last] / 127) * self._envelope(tab, t, i)
+        # weight from one foot to the other over two beats, on a foot at each beat; the
+        # spine dipping deepest just after each beat (``dip_after_beat`` of a beat)
         phase = np.asarray(beat_phase, dtype=np.float64)[rows]
         two = (np.asarray(beat_index)[rows] % 2 + phase) / 2.0
-        sway = s.sway_rad * loud * np.sin(2 * np.pi * two)
-        dip = s.dip_rad * loud * np.sin(np.pi * phase) ** 2
+        sway = s.sway_rad * loud * np.cos(2 * np.pi * two)
+        dip = s.dip_rad * loud * (0.5 + 0.5 * np.cos(2 * np.pi * (phase - s.dip_after_beat)))
         # the chest turns with the fretting hand: lower on the neck, further toward the bass
         # (where the fingertip is along the neck: it moves on continuously between notes)
         held = tab.has_fretted(i)
         out[rows] = self._moved(loc, root, sway, dip, held, self._vibrato_many(t, last))
         return out
+
+    def _envelope(self, tab: _NoteTable, t: np.ndarray, i: np.ndarray) -> np.ndarray:
+        """How much the body moves (m,) at times ``t`` whose notes struck so far are
+        ``[:i]``: fully while playing; 2 s after a note it settles over a second; it
+        comes back over ``body_ramp_s`` before the next note, and grows over that long
+        after the first.  Continuous in time (a max of continuous windows)."""
+        ramp = self.settings.body_ramp_s
+        after = np.clip(3.0 - (t - tab.impact[i - 1]), 0.0, 1.0)
+        nxt = np.append(tab.impact, math.inf)[i]
+        before = np.clip(1.0 + (t - nxt) / ramp, 0.0, 1.0)
+        first = np.clip((t - tab.impact[0]) / ramp, 0.0, 1.0)
+        return np.asarray(np.maximum(after, before) * first)
 
     def lean(self, chest: np.ndarray, rest_chest: np.ndarray) -> np.ndarray:
         """The bass's lean (..., 4) for the chest at ``chest`` (..., 3) (see
@@ -448,31 +472,49 @@ class Bassist:
 
     def _wrist_beside_board(
         self, wrist: np.ndarray, tip: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The fretting wrists (m, 3) moved round their fingertips (m, 3) (the hand turned
-        about the tip, the tip kept) to lie beside the fingerboard's E edge, or as near it
-        as the hand reaches; and the turns (m, 4) of the hands.  A wrist already beside
+        about the tip, the tip kept) to lie beside the fingerboard's low edge; where the
+        hand cannot reach round it (a high string on a wide board, high up the neck), as
+        near it as ``reach_share`` of the hand reaches, the wrist rising in front of the
+        strings (the hand arched over the board, as in thumb position) by up to
+        ``arch_m`` as it stays over the board by up to ``arch_ramp_m``; the turns (m, 4)
+        of the hands; and how far each hand is arched (m,), 0..1.  A wrist already beside
         the board stays."""
+        s = self.settings
         n = self.neck
         rel = wrist - tip
         length = np.linalg.norm(rel, axis=-1)
-        need = BOARD_HALF_WIDTH_M + WRIST_BESIDE_M
+        c_tip = n.coords(tip)
+        need = n.low_edge(c_tip[:, 0]) + WRIST_BESIDE_M
         move = (n.coords(wrist)[:, 1] < need) & (length >= 1e-9)
         turn = quat.identity((len(wrist),))
+        arched = np.zeros(len(wrist))
         if not move.any():
-            return wrist, turn
+            return wrist, turn, arched
         rel, length, tip = rel[move], length[move], tip[move]
-        d_lat = np.minimum(need - n.coords(tip)[:, 1], length)
-        other = rel - (rel @ n.lateral)[:, None] * n.lateral
-        norm = np.linalg.norm(other, axis=-1)
+        d_need = need[move] - c_tip[move, 1]
+        d_lat = np.minimum(d_need, s.reach_share * length)
+        short = d_need - d_lat  # how far the wrist stays over the board's edge
+        # the rest of the hand's length in the plane (along, face), in the direction the
+        # clip had it, its face part raised as the wrist stays over the board
+        r = np.sqrt(np.maximum(length**2 - d_lat**2, 0.0))
+        along = rel @ n.along
+        face = rel @ n.face
+        norm = np.hypot(along, face)
         ok = norm > 1e-9
-        other = np.where(ok[:, None], other / np.where(ok, norm, 1.0)[:, None], n.face)
-        side = np.sqrt(np.maximum(length**2 - d_lat**2, 0.0))
-        new = d_lat[:, None] * n.lateral + side[:, None] * other
+        f0 = np.where(ok, face / np.where(ok, norm, 1.0), 1.0)
+        a0 = np.where(ok, along / np.where(ok, norm, 1.0), 0.0)
+        ramp = np.clip(short / s.arch_ramp_m, 0.0, 1.0)
+        lift = -r + (np.minimum(s.arch_m, r) + r) * ramp  # -r (none) .. arch_m
+        f = np.maximum(r * f0, lift)
+        a = np.where(a0 >= 0.0, 1.0, -1.0) * np.sqrt(np.maximum(r**2 - f**2, 0.0))
+        new = d_lat[:, None] * n.lateral + a[:, None] * n.along + f[:, None] * n.face
         out = wrist.copy()
         out[move] = tip + new
         turn[move] = quat.from_two_vectors(rel, new)
-        return out, turn
+        arched[move] = ramp
+        return out, turn, arched
 
     def _posed(
         self,
@@ -554,7 +596,9 @@ class Bassist:
         targets = wpos[:, _HANDS].copy()
         hand_rot = quat.from_matrix(wrot[:, _HANDS])
         # the fretting wrist beside the board's E edge, so the forearm stays behind the neck
-        targets[:, 0], turn_hand = self._wrist_beside_board(wpos[:, _HANDS[0]], wpos[:, _LTIP])
+        targets[:, 0], turn_hand, arched = self._wrist_beside_board(
+            wpos[:, _HANDS[0]], wpos[:, _LTIP]
+        )
         hand_rot[:, 0] = quat.multiply(turn_hand, hand_rot[:, 0])
         targets[:, 0] += vibrato
         rest_chest = wpos[:, CHEST]
@@ -597,6 +641,12 @@ class Bassist:
         # (the forearm comes round behind the neck, not across the board)
         push = np.minimum(np.maximum(-neck_tip[:, 1], 0.0) * POLE_PUSH_PER_M, POLE_PUSH_MAX_M)
         poles[:, 0] += push[:, None] * quat.rotate(q, self.neck.lateral)
+        # and, with the hand arched over the board, raised toward the front so the forearm
+        # comes round the board's low edge instead of through it
+        lift = arched**3 * self.settings.arch_elbow_m
+        poles[:, 0] += lift[:, None] * quat.rotate(q, self.neck.face)
+        out_more = np.maximum(arched * POLE_PUSH_MAX_M - push, 0.0)  # and well out to the side
+        poles[:, 0] += out_more[:, None] * quat.rotate(q, self.neck.lateral)
         m = len(loc)
         upper, lower = _two_bone(
             moved_pos[:, _ARMS].reshape(-1, 3), leaned.reshape(-1, 3), poles.reshape(-1, 3)

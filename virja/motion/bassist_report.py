@@ -9,12 +9,16 @@ Sampled from the animator at 30 fps (what a viewer sees) and 120 fps (speeds):
 - **torso range** (degrees): the largest angle between the chest's orientations
   at any two frames;
 - **collisions**: frames where the centre line of a hand or forearm passes
-  through the fingerboard (a 7 cm x 1.4 cm board behind the strings, nut to its
-  end) or the bass's body (the ellipsoids drawn);
-- **fretting hand on the correct side** (share of frames): the left wrist on
-  the E side of the fingerboard (the side the arm comes from, thumb behind the
-  neck), not in front of the strings by more than 2 cm, and the elbow behind
-  the strings;
+  through the fingerboard (1.4 cm thick behind the strings, as wide as the
+  tuning's strings need: :mod:`virja.fingerboard`; nut to its end) or the
+  neck behind it, or the bass's body (the ellipsoids drawn);
+- **fretting hand on the correct side** (share of frames): the left wrist
+  toward the low (E, B) side from the fingertip, and either beside the board
+  (at most 1 cm over its low edge, less than 2 cm in front of the fingertip,
+  the elbow behind the strings: the thumb behind the neck) or, where the hand
+  cannot reach round a wide board, arched over it (2 cm or more in front, as
+  in thumb position) with the elbow out beyond the low edge
+  (:func:`virja.motion.bassist.fretting_side`);
 - **shifts per stopped note**: how often the hand position (``_pos`` in the
   motion name) changes.
 """
@@ -29,7 +33,7 @@ import numpy as np
 from virja import quat
 from virja.motion import bass_lean
 from virja.motion.band import BandAnimator, PlannedNoteLike
-from virja.motion.bassist import BOARD_BACK_M, BOARD_FACE_M, BOARD_HALF_WIDTH_M, neck_frame
+from virja.motion.bassist import fretting_side, neck_frame
 from virja.motion.metrics import MotionReport
 from virja.motion.skeleton import SKELETON
 from virja.vocab import BassPluck
@@ -129,29 +133,10 @@ def _frames(
     return np.array(pos), np.array(rot), np.array(fingers), np.array(own)
 
 
-def _neck_frame(
-    animator: BandAnimator,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
-    """(nut centre, along the strings, lateral toward E, out of the board face, board
-    length): the fingerboard as render.scene draws it, along the strings."""
-    n = neck_frame(animator.geometry)
-    return n.nut, n.along, n.lateral, n.face, n.length
-
-
 def _in_board(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
-    """Which points (..., 3) lie inside the fingerboard and the neck behind it."""
-    nut, along, lateral, face, length = _neck_frame(animator)
-    rel = points - nut
-    u = rel @ along
-    lat = rel @ lateral
-    fr = rel @ face
-    return (
-        (u > 0.0)
-        & (u < length)
-        & (np.abs(lat) < BOARD_HALF_WIDTH_M)
-        & (fr < BOARD_FACE_M)
-        & (fr > BOARD_BACK_M)
-    )
+    """Which points (..., 3) lie inside the fingerboard (as wide as the tuning's strings,
+    :mod:`virja.fingerboard`) and the neck behind it."""
+    return neck_frame(animator.geometry, animator.bass_strings).inside(points)
 
 
 def _in_body(points: np.ndarray, animator: BandAnimator) -> np.ndarray:
@@ -203,15 +188,12 @@ def measure_bassist(
         pts = pa[None] + u * (pb - pa)[None]  # (9, k, 3)
         hit = _in_board(pts, animator) | _in_body(pts, animator)
         collide |= hit.any(axis=0)
-    nut, _, lateral, front, _ = _neck_frame(animator)
-    wrist = own[:, _SK.index("LeftHand")] - nut
-    elbow = own[:, _SK.index("LeftForeArm")] - nut
-    tip = own[:, _SK.index("LeftHandEnd")] - nut
-    side = (
-        (wrist @ lateral > tip @ lateral)
-        & (wrist @ lateral > BOARD_HALF_WIDTH_M - 0.01)
-        & (wrist @ front - tip @ front < 0.02)
-        & (elbow @ front < 0.0)
+    board = neck_frame(animator.geometry, animator.bass_strings)
+    side = fretting_side(
+        board,
+        own[:, _SK.index("LeftForeArm")],
+        own[:, _SK.index("LeftHand")],
+        own[:, _SK.index("LeftHandEnd")],
     )
     positions = [
         p.motion.position if isinstance(p.motion, BassPluck) else None

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from virja import quat
+from virja.fingerboard import fingerboard
 from virja.geometry import GEOMETRY, Cymbal, Drum, Geometry
 from virja.motion.pose import LEFT_FINGER_BONES, BandPose, FigurePose
 from virja.render.meshes import (
@@ -123,35 +124,45 @@ def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
     return dl.freeze()
 
 
-_BASS_TABLES: dict[int, tuple[Geometry, dict[str, tuple[F64, F64]]]] = {}
+_BASS_TABLES: dict[tuple[int, tuple[str, ...]], tuple[Geometry, dict[str, tuple[F64, F64]]]] = {}
 
 
-def _bass_table(geo: Geometry) -> dict[str, tuple[F64, F64]]:
+def _bass_table(
+    geo: Geometry, strings: tuple[str, ...] = BASS_STRINGS
+) -> dict[str, tuple[F64, F64]]:
     """The upright bass's instances (models, colours) per kind in its own frame, built once
-    per geometry."""
-    hit = _BASS_TABLES.get(id(geo))
+    per geometry and tuning (the fingerboard is as wide as the tuning's strings)."""
+    hit = _BASS_TABLES.get((id(geo), strings))
     if hit is not None and hit[0] is geo:
         return hit[1]
     dl = DrawList()
-    _bass_static(dl, geo)
+    _bass_static(dl, geo, strings)
     table = {k: (np.concatenate(dl.models[k]), np.concatenate(dl.colors[k])) for k in dl.models}
-    _BASS_TABLES[id(geo)] = (geo, table)
+    _BASS_TABLES[(id(geo), strings)] = (geo, table)
     return table
 
 
-def _bass_instrument(dl: DrawList, geo: Geometry, transform: F64) -> None:
+def _tuning(geo: Geometry, pose: BandPose) -> tuple[str, ...]:
+    """The strings of the pose's tuning (four, five or six), low to high."""
+    return tuple(s for s in geo.bass.strings if s in pose.string_vibration) or BASS_STRINGS
+
+
+def _bass_instrument(
+    dl: DrawList, geo: Geometry, transform: F64, strings: tuple[str, ...] = BASS_STRINGS
+) -> None:
     """The bass's body, neck, fingerboard, bridge, tailpiece and endpin, leaning as
     ``transform`` (4, 4) says (``BandPose.bass_transform``)."""
     m = np.asarray(transform, dtype=np.float64)
-    for kind, (models, colors) in _bass_table(geo).items():
+    for kind, (models, colors) in _bass_table(geo, strings).items():
         dl.add(kind, models if np.array_equal(m, _EYE) else m @ models, colors)
 
 
 _EYE = np.eye(4)
 
 
-def _bass_static(dl: DrawList, geo: Geometry) -> None:
-    """The bass's parts in its own frame (:mod:`virja.geometry`, not leaning)."""
+def _bass_static(dl: DrawList, geo: Geometry, strings: tuple[str, ...] = BASS_STRINGS) -> None:
+    """The bass's parts in its own frame (:mod:`virja.geometry`, not leaning), its
+    fingerboard and bridge as wide as ``strings`` (the tuning's) need."""
     b = geo.bass
     up = b.axis
     # the body: lower and upper bouts as flattened spheres, a waist between
@@ -184,21 +195,18 @@ def _bass_static(dl: DrawList, geo: Geometry) -> None:
         WOOD,
     )
     dl.add("sphere", sphere_transforms([nut_c + 0.10 * up - 0.02 * b.front], 0.05), WOOD)
-    # fingerboard: a long thin box from the nut down past the neck joint
-    # (along the strings, which rise off the neck toward the bridge: its face stays 4 mm
-    # behind them from the nut down)
-    fb_end = nut_c + 0.78 * (bridge_c - nut_c)
-    along = (fb_end - nut_c) / np.linalg.norm(fb_end - nut_c)
-    face = b.front - np.dot(b.front, along) * along
-    face /= np.linalg.norm(face)
-    board = np.stack([np.cross(along, face), along, face], axis=1)
-    mid = (nut_c + fb_end) / 2 - 0.011 * face
-    length = float(np.linalg.norm(fb_end - nut_c))
-    dl.add("box", box_transforms([mid], [[0.07, length, 0.014]], board[None]), EBONY)
+    # the fingerboard: from the nut down past the neck joint, tapering with the tuning's
+    # strings (virja.fingerboard; its face 4 mm behind them), drawn as three sheared boxes
+    board = fingerboard(b, strings)
+    dl.add("box", board.pieces(), EBONY)
     # bridge and tailpiece
     dl.add(
         "box",
-        box_transforms([bridge_c - 0.02 * b.front], [[0.13, 0.08, 0.012]], _orient(b)[None]),
+        box_transforms(
+            [bridge_c - 0.02 * b.front],
+            [[_bridge_width(b, strings), 0.08, 0.012]],
+            _orient(b)[None],
+        ),
         (0.75, 0.6, 0.4, 0.2),
     )
     dl.add(
@@ -209,6 +217,13 @@ def _bass_static(dl: DrawList, geo: Geometry) -> None:
         EBONY,
     )
     dl.add("cylinder", segment_transforms([b.endpin], [b.endpin + 0.2 * up], 0.008), CHROME)
+
+
+def _bridge_width(b: Any, strings: tuple[str, ...]) -> float:
+    """The bridge: 13 cm, or the tuning's strings' spread on it and 1 cm beyond each."""
+    lateral = _orient(b)[:, 0]
+    lat = [float(b.bridge[s] @ lateral) for s in strings]
+    return max(0.13, max(lat) - min(lat) + 0.02)
 
 
 def _orient(b: Any) -> F64:
@@ -258,7 +273,7 @@ def band_scene(pose: BandPose, geo: Geometry = GEOMETRY) -> DrawList:
     dl.add("cylinder", np.concatenate([kit_cyl, seg]), np.concatenate([kit_color, seg_color]))
     sph, sph_color = _sphere_rows(parts)
     dl.add("sphere", sph, sph_color)
-    _bass_instrument(dl, geo, pose.bass_transform)
+    _bass_instrument(dl, geo, pose.bass_transform, _tuning(geo, pose))
     return dl
 
 

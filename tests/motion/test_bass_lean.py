@@ -25,8 +25,8 @@ def played(library: MotionLibrary) -> tuple[BandAnimator, list[PlannedNote]]:
         a.add_beat(Beat(0.5 * i, 0, i // 4 + 1, i % 4 + 1, 4, 500_000))
     notes = []
     for i, (s, f) in enumerate(LINE):
-        # off the beat, where the weight is on one foot (on the beat it passes the centre)
-        p = bass(s, f, 0.55 + 0.5 * i, 0.75 + 0.5 * i, velocity=110)
+        # on the beat, where the weight is on one foot (off the beat it passes the centre)
+        p = bass(s, f, 0.8 + 0.5 * i, 1.0 + 0.5 * i, velocity=110)
         a.add_planned(p)
         notes.append(p)
     return a, notes

@@ -501,10 +501,7 @@ class BandAnimator:
         # the fingers are laid out in the bass's own frame, then leaned with it
         rot, shift = leans[:, :3, :3], leans[:, :3, 3]
         own = (wpos[:, 1] - shift[:, None, :]) @ rot
-        fingers = np.array([self.bassist.fingers(t, own[k]) for k, t in enumerate(tl)])
-        fingers = (
-            fingers.reshape(ts.size, -1, 2, 3) if fingers.size else np.zeros((ts.size, 0, 2, 3))
-        )
+        fingers = self.bassist.fingers_many(ts, own)  # all frames in one numpy pass
         fingers = np.einsum("mkpj,mij->mkpi", fingers, rot) + shift[:, None, None, :]
         return BandPoses(
             times=ts,

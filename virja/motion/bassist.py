@@ -102,6 +102,7 @@ _HANDS = [_SK.index("LeftHand"), _SK.index("RightHand")]
 _SHOULDERS = [_SK.index("LeftShoulder"), _SK.index("RightShoulder")]
 CHEST = _SK.index("Chest")
 _LTIP = _SK.index("LeftHandEnd")
+_FINGER_BONES = 17  # the left hand's 10 (four fingers of two, the thumb's two), the right's 7
 
 # the fretting wrist beside the fingerboard's low (E, B) edge (virja.fingerboard), this far out
 WRIST_BESIDE_M = 0.005
@@ -207,6 +208,12 @@ def _position_of(motion: MotionKey, fret: int) -> int:
     return pos if pos is not None else max(fret, 1)
 
 
+def _unit_rows(v: np.ndarray) -> np.ndarray:
+    """:func:`_unit` of each row of ``v`` (m, 3)."""
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.where(n > 1e-12, v / np.where(n > 1e-12, n, 1.0), v)
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     n = float(np.linalg.norm(v))
     return v / n if n > 1e-12 else v
@@ -297,6 +304,119 @@ class Bassist:
         segs += self._left(t, wpos)
         segs += self._right(t, wpos)
         return np.array([[a, b] for a, b in segs]).reshape(-1, 2, 3)
+
+    def fingers_many(self, times: np.ndarray, wpos: np.ndarray) -> np.ndarray:
+        """:meth:`fingers` at many times at once: (m, k, 2, 3) for ``times`` (m,) and the
+        joint positions ``wpos`` (m, n, 3); one numpy pass over all frames (equal to
+        :meth:`fingers` frame by frame, tests/motion/test_bassist_fingers_batch.py)."""
+        t = np.asarray(times, dtype=np.float64)
+        wpos = np.asarray(wpos, dtype=np.float64)
+        tab = self._note_table()
+        starts = tab.start
+        if t.size == 0:
+            return np.zeros((0, _FINGER_BONES, 2, 3))
+        # no notes yet, or notes added out of order: frame by frame
+        if starts.size == 0 or np.any(np.diff(starts) < 0):
+            return np.stack([self.fingers(float(x), w) for x, w in zip(t, wpos, strict=True)])
+        return np.concatenate(
+            [self._left_many(t, wpos, tab), self._right_many(t, wpos, tab)], axis=1
+        )
+
+    def _incoming_many(
+        self, t: np.ndarray, tab: _NoteTable, stopped: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_incoming` at times ``t`` (m,): indices of (previous, next) notes (-1:
+        none) and ``w``."""
+        rows = tab.fretted if stopped else np.arange(tab.impact.size)
+        i = np.searchsorted(tab.impact, t + 1.0, side="right")  # notes struck by t + 1 s
+        lo = np.maximum(i - 48, 0)  # the window the per-frame version looks in
+        k_end = np.searchsorted(rows, i, side="left")  # filtered notes before i
+        k = np.minimum(np.searchsorted(tab.start[rows], t, side="right"), k_end) - 1
+        row = np.where(k >= 0, rows[np.maximum(k, 0)] if rows.size else 0, -1)
+        nxt = np.where((k >= 0) & (row >= lo), row, -1)
+        prow = np.where(k >= 1, rows[np.maximum(k - 1, 0)] if rows.size else 0, -1)
+        prev = np.where((nxt >= 0) & (prow >= lo), prow, -1)
+        j = np.maximum(nxt, 0)
+        span = tab.impact[j] - tab.start[j]  # (there is a note: fingers_many checks)
+        safe = np.where(span > 1e-9, span, 1.0)
+        u = np.where(span <= 1e-9, 1.0, np.clip((t - tab.start[j]) / safe, 0.0, 1.0))
+        w = np.where(nxt >= 0, u * u * (3.0 - 2.0 * u), 1.0)
+        return prev, nxt, w
+
+    def _layouts(self, tab: _NoteTable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_layout` of every note and of the rest position (the last row): tips
+        (k + 1, 4, 3), thumbs (k + 1, 3), and the stopping finger (k + 1,)."""
+        if tab.layouts is None:
+            lay = [self._layout(n) for n in self._notes] + [self._layout(None)]
+            tips = np.array([a for a, _ in lay]).reshape(-1, 4, 3)
+            thumbs = np.array([b for _, b in lay]).reshape(-1, 3)
+            stopping = np.argmin(np.linalg.norm(tips, axis=-1), axis=-1)
+            object.__setattr__(tab, "layouts", (tips, thumbs, stopping))
+        assert tab.layouts is not None
+        return tab.layouts
+
+    def _left_many(self, t: np.ndarray, wpos: np.ndarray, tab: _NoteTable) -> np.ndarray:
+        s = self.settings
+        front = self.geometry.bass.front
+        tip = wpos[:, _SK.index("LeftHandEnd")]
+        wrist = wpos[:, _SK.index("LeftHand")]
+        prev, nxt, w = self._incoming_many(t, tab, stopped=True)
+        tips, thumbs, stopping = self._layouts(tab)
+        rest = len(tips) - 1
+        a = np.where(prev >= 0, prev, np.where(nxt >= 0, nxt, rest))
+        b = np.where(nxt >= 0, nxt, rest)
+        offs = (1.0 - w)[:, None, None] * tips[a] + w[:, None, None] * tips[b]  # (m, 4, 3)
+        thumb_tip = (1.0 - w)[:, None] * thumbs[a] + w[:, None] * thumbs[b]
+        last = np.searchsorted(tab.impact, t, side="right") - 1
+        j = np.maximum(nxt, 0)
+        pressing = (nxt >= 0) & (last == nxt) & (t < tab.off[j]) & (tab.impact[j] <= t)
+        press = pressing.astype(np.float64)[:, None]
+        not_stopping = np.arange(4)[None, :] != stopping[b][:, None]  # (m, 4)
+        rise = s.hover_m * not_stopping * press + s.lift_m * (1.0 - press)  # (m, 4)
+        back = _unit_rows(wrist - tip)[:, None]
+        ftip = tip[:, None] + offs + rise[..., None] * front
+        knuckle = tip[:, None] + offs * 0.6 + s.finger_len_m * back
+        mid = 0.5 * (knuckle + ftip) + 0.35 * s.finger_len_m * front
+        m = len(t)
+        out = np.empty((m, 10, 2, 3))
+        out[:, 0:8:2, 0], out[:, 0:8:2, 1] = knuckle, mid
+        out[:, 1:8:2, 0], out[:, 1:8:2, 1] = mid, ftip
+        thumb_base = wrist + 0.3 * (tip - wrist)
+        thumb_mid = 0.5 * (thumb_base + thumb_tip) - 0.01 * front
+        out[:, 8, 0], out[:, 8, 1] = thumb_base, thumb_mid
+        out[:, 9, 0], out[:, 9, 1] = thumb_mid, thumb_tip
+        return out
+
+    def _right_many(self, t: np.ndarray, wpos: np.ndarray, tab: _NoteTable) -> np.ndarray:
+        s = self.settings
+        b = self.geometry.bass
+        tip = wpos[:, _SK.index("RightHandEnd")]
+        wrist = wpos[:, _SK.index("RightHand")]
+        prev, nxt, w = self._incoming_many(t, tab, stopped=False)
+        finger = np.where(nxt >= 0, tab.right_finger[np.maximum(nxt, 0)], 0)
+        first = np.where(prev >= 0, w, 1.0)  # the plucking finger's share
+        plucking = np.where(np.arange(2)[None, :] == finger[:, None], first[:, None], 0.0)
+        plucking = np.where(
+            np.arange(2)[None, :] == finger[:, None], plucking, 1.0 - first[:, None]
+        )
+        along = b.string_dir("A")
+        back = _unit_rows(wrist - tip)
+        side = np.array([-0.02, 0.02])[None, :, None]  # index toward the nut, middle beside
+        rest = side * along + s.hover_m * 2 * b.front  # (1, 2, 3)
+        ftip = tip[:, None] + (1.0 - plucking)[..., None] * rest
+        knuckle = tip[:, None] + 0.6 * side * along + s.finger_len_m * back[:, None]
+        mid = 0.5 * (knuckle + ftip) + 0.25 * s.finger_len_m * b.front
+        m = len(t)
+        out = np.empty((m, 7, 2, 3))
+        out[:, 0:4:2, 0], out[:, 0:4:2, 1] = knuckle, mid
+        out[:, 1:4:2, 0], out[:, 1:4:2, 1] = mid, ftip
+        palm = tip + 0.6 * s.finger_len_m * back
+        for k, off in enumerate((0.035, 0.05)):
+            out[:, 4 + k, 0] = palm + off * along
+            out[:, 4 + k, 1] = palm + off * along - 0.02 * back + 0.01 * b.front
+        out[:, 6, 0] = tip + s.finger_len_m * back - 0.02 * along
+        out[:, 6, 1] = tip - 0.06 * along + 0.02 * b.front + 0.02 * self._lateral
+        return out
 
     def _incoming(self, t: float, stopped: bool) -> tuple[_Note | None, _Note | None, float]:
         """(previous, next, w): the hand goes from ``previous``'s note to ``next``'s, ``w``
@@ -688,6 +808,9 @@ class _NoteTable:
     fret: np.ndarray
     string_dir: np.ndarray  # (k, 3)
     fretted: np.ndarray  # indices of the stopped notes
+    right_finger: np.ndarray  # (k,) 0 index, 1 middle
+    # the left hand's finger layouts (Bassist._layouts), filled in when first asked for
+    layouts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def of(cls, notes: list[_Note], geometry: Geometry) -> _NoteTable:
@@ -702,6 +825,7 @@ class _NoteTable:
             fret=fret,
             string_dir=np.array([dirs[n.string] for n in notes]).reshape(-1, 3),
             fretted=np.nonzero(fret > 0)[0],
+            right_finger=np.array([n.right_finger for n in notes], dtype=np.int64),
         )
 
     def has_fretted(self, i: np.ndarray) -> np.ndarray:

@@ -89,7 +89,8 @@ def _plain_wrist_beside_board(
     f = max(r * f0, -r + (min(s.arch_m, r) + r) * ramp)
     a = math.copysign(math.sqrt(max(r**2 - f**2, 0.0)), 1.0 if a0 >= 0.0 else -1.0)
     new = d_lat * n.lateral + a * n.along + f * n.face
-    return tip + new, quat.from_two_vectors(rel, new), ramp
+    elbow_ramp = min(max((d_need - d_lat) / (3.0 * s.arch_ramp_m), 0.0), 1.0)
+    return tip + new, quat.from_two_vectors(rel, new), elbow_ramp
 
 
 def _plain_reach_with_shoulder(
@@ -118,10 +119,11 @@ def plain_body(
     s = b.settings
     wpos, wrot = _SK.fk(loc, root)
     held = b.fretted(t)
-    last = b.current(t)
-    if last is None:
+    if not b._notes:
         return loc
-    i = bisect.bisect_right(b._times, t) - 1
+    # before the first note: its envelope is 0 (the body still), the arm goes round the board
+    last = b.current(t) or b._notes[0]
+    i = max(bisect.bisect_right(b._times, t) - 1, 0)
     ramp = s.body_ramp_s
     after = min(max(3.0 - (t - last.impact), 0.0), 1.0)
     nxt = b._notes[i + 1].impact if i + 1 < len(b._notes) else math.inf
@@ -172,7 +174,7 @@ def plain_body(
     across = -float(b.neck.coords(wpos[_LTIP])[1])
     push = min(max(across, 0.0) * POLE_PUSH_PER_M, POLE_PUSH_MAX_M)
     poles[0] += push * quat.rotate(q, b.neck.lateral)
-    poles[0] += arched**3 * s.arch_elbow_m * quat.rotate(q, b.neck.face)
+    poles[0] += arched * s.arch_elbow_m * quat.rotate(q, b.neck.face)
     poles[0] += max(arched * POLE_PUSH_MAX_M - push, 0.0) * quat.rotate(q, b.neck.lateral)
     upper, lower = _two_bone(moved_pos[_ARMS], leaned, poles)
     out[_ARMS] = quat.multiply(quat.conjugate(moved_rot[_SHOULDERS]), upper)

@@ -80,7 +80,7 @@ class BassistSettings:
     reach_share: float = 0.8  # the fretting wrist beside the board: at most this much of the
     arch_m: float = 0.05  # hand sideways; beyond, it rises this far in front of the strings
     arch_ramp_m: float = 0.01  # as it stays this far over the board's low edge
-    arch_elbow_m: float = 0.8  # the arched hand's elbow pole raised this far toward the front
+    arch_elbow_m: float = 0.8  # the arched hand's elbow pole raised up to this far to the front
 
 
 @dataclass
@@ -555,11 +555,12 @@ class Bassist:
         out = loc.copy()
         tab = self._note_table()
         i = np.searchsorted(tab.impact, t, side="right")
-        rows = np.nonzero(i > 0)[0]  # before the first note the player stands still
-        if rows.size == 0:
+        if tab.impact.size == 0:  # no notes yet: the player stands still
             return out
-        t, i, loc = t[rows], i[rows], loc[rows]
-        last = i - 1
+        # every frame, those before the first note too: the body stands still there (the
+        # envelope is 0) but the fretting arm goes round the board as it will at the note
+        rows = np.arange(len(t))
+        last = np.maximum(i - 1, 0)
         loud = (0.6 + 0.4 * tab.velocity[last] / 127) * self._envelope(tab, t, i)
         # weight from one foot to the other over two beats, on a foot at each beat; the
         # spine dipping deepest just after each beat (``dip_after_beat`` of a beat)
@@ -579,7 +580,7 @@ class Bassist:
         comes back over ``body_ramp_s`` before the next note, and grows over that long
         after the first.  Continuous in time (a max of continuous windows)."""
         ramp = self.settings.body_ramp_s
-        after = np.clip(3.0 - (t - tab.impact[i - 1]), 0.0, 1.0)
+        after = np.clip(3.0 - (t - tab.impact[np.maximum(i - 1, 0)]), 0.0, 1.0)
         nxt = np.append(tab.impact, math.inf)[i]
         before = np.clip(1.0 + (t - nxt) / ramp, 0.0, 1.0)
         first = np.clip((t - tab.impact[0]) / ramp, 0.0, 1.0)
@@ -599,8 +600,9 @@ class Bassist:
         near it as ``reach_share`` of the hand reaches, the wrist rising in front of the
         strings (the hand arched over the board, as in thumb position) by up to
         ``arch_m`` as it stays over the board by up to ``arch_ramp_m``; the turns (m, 4)
-        of the hands; and how far each hand is arched (m,), 0..1.  A wrist already beside
-        the board stays."""
+        of the hands; and how far each hand is arched for its elbow (m,), 0..1 as the
+        wrist stays up to three times ``arch_ramp_m`` over the edge (the elbow rises over
+        a few frames).  A wrist already beside the board stays."""
         s = self.settings
         n = self.neck
         rel = wrist - tip
@@ -633,7 +635,7 @@ class Bassist:
         out = wrist.copy()
         out[move] = tip + new
         turn[move] = quat.from_two_vectors(rel, new)
-        arched[move] = ramp
+        arched[move] = np.clip(short / (3.0 * s.arch_ramp_m), 0.0, 1.0)
         return out, turn, arched
 
     def _posed(
@@ -763,7 +765,7 @@ class Bassist:
         poles[:, 0] += push[:, None] * quat.rotate(q, self.neck.lateral)
         # and, with the hand arched over the board, raised toward the front so the forearm
         # comes round the board's low edge instead of through it
-        lift = arched**3 * self.settings.arch_elbow_m
+        lift = arched * self.settings.arch_elbow_m
         poles[:, 0] += lift[:, None] * quat.rotate(q, self.neck.face)
         out_more = np.maximum(arched * POLE_PUSH_MAX_M - push, 0.0)  # and well out to the side
         poles[:, 0] += out_more[:, None] * quat.rotate(q, self.neck.lateral)

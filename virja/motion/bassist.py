@@ -80,7 +80,7 @@ class BassistSettings:
     reach_share: float = 0.8  # the fretting wrist beside the board: at most this much of the
     arch_m: float = 0.05  # hand sideways; beyond, it rises this far in front of the strings
     arch_ramp_m: float = 0.01  # as it stays this far over the board's low edge
-    arch_elbow_m: float = 0.8  # the arched hand's elbow pole raised up to this far to the front
+    arch_elbow_m: float = 0.55  # the arched hand's elbow pole raised up to this far to the front
 
 
 @dataclass

@@ -78,7 +78,7 @@ class BassistSettings:
     long_note_s: float = 0.45  # notes at least this long get vibrato
     lean_follow: float = 0.8  # the bass's contact point follows this much of the chest's move
     reach_share: float = 0.8  # the fretting wrist beside the board: at most this much of the
-    arch_m: float = 0.05  # hand sideways; beyond, it rises this far in front of the strings
+    arch_m: float = 0.045  # hand sideways; beyond, it rises this far in front of the strings
     arch_ramp_m: float = 0.01  # as it stays this far over the board's low edge
     arch_elbow_m: float = 0.55  # the arched hand's elbow pole raised up to this far to the front
 

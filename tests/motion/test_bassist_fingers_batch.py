@@ -1,5 +1,5 @@
 """The bassist's fingers posed for many frames at once (``Bassist.fingers_many``, used by
-``BandAnimator.poses``) equal the per-frame ``Bassist.fingers`` on the demo, on a line
+``BandAnimator.pose_batch``) equal the per-frame ``Bassist.fingers`` on the demo, on a line
 with open strings, note-offs and thumb position, on a six-string, and with notes added
 out of order."""
 

@@ -134,7 +134,9 @@ def band_scenes(batch: BandPoses, geo: Geometry = GEOMETRY) -> list[DrawList]:
         "sphere": [(sph, sph_color)],
     }
     lean = np.asarray(batch.bass_transform, dtype=np.float64)
-    for kind, (models, colors) in _bass_table(geo).items():
+    # the fingerboard as wide as the tuning's strings (virja.fingerboard), as band_scene
+    tuning = tuple(x for x in geo.bass.strings if x in batch.strings) or BASS_STRINGS
+    for kind, (models, colors) in _bass_table(geo, tuning).items():
         moved = lean[:, None] @ models[None]  # the bass leans with its player
         per_kind.setdefault(kind, []).append((moved, np.broadcast_to(colors, (m,) + colors.shape)))
     packed: dict[str, NDArray[np.float32]] = {}

@@ -131,6 +131,9 @@ class Performance:
     def feed_routed(self, performer: Performer, event: Event, *, now_s: float) -> None:
         """An event already routed (jam's keyboard split does its own routing)."""
         if isinstance(event, NoteOn):
+            known = getattr(self.animator, "note_known", None)
+            if known is not None and performer == "drums":  # a free hand may start toward it
+                known(performer, event, now_s)
             self.planner.add_note(performer, event, now_s=now_s)
             self.counts[f"notes_{performer}"] += 1
         elif isinstance(event, NoteOff):

@@ -113,6 +113,10 @@ class FrameLoop:
             if kind == "planned":
                 self.animator.add_planned(item[1])
                 self.received += 1
+            elif kind == "known":  # a note's arrival: a free hand may move toward it
+                known = getattr(self.animator, "note_known", None)
+                if known is not None:
+                    known(item[1], item[2], item[3])
             elif kind == "beat":
                 self.animator.add_beat(item[1])
                 self.hud.add(item[1])

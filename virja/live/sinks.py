@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-from virja.events import Beat, Chord, NoteOff
+from virja.events import Beat, Chord, NoteOff, NoteOn
 from virja.motion.pose import BandPose
 from virja.plan.types import PlannedNote
 from virja.session import PlanSink
@@ -51,6 +51,13 @@ class Fanout:
     def add_planned(self, p: PlannedNote) -> None:
         for s in self.sinks:
             s.add_planned(p)
+
+    def note_known(self, performer: Performer, note: NoteOn, at_s: float) -> None:
+        """When a note became known, to every sink that animates a drummer's hands."""
+        for s in self.sinks:
+            call = getattr(s, "note_known", None)
+            if call is not None:
+                call(performer, note, at_s)
 
     def add_beat(self, beat: Beat) -> None:
         for s in self.sinks:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from virja.errors import NotAvailableError
-from virja.events import Beat, Chord, NoteOff
+from virja.events import Beat, Chord, NoteOff, NoteOn
 from virja.plan.types import PlannedNote
 from virja.vocab import Performer
 
@@ -109,6 +109,10 @@ class Viewer:
     # -- the plan sink ---------------------------------------------------------
     def add_planned(self, p: PlannedNote) -> None:
         self._put(("planned", p))
+
+    def note_known(self, performer: Performer, note: NoteOn, at_s: float) -> None:
+        """When a note became known: the window's drummer may move toward it from then."""
+        self._put(("known", performer, note, at_s))
 
     def add_beat(self, beat: Beat) -> None:
         self._put(("beat", beat))

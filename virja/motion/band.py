@@ -174,6 +174,10 @@ class BandAnimator:
         self._bass_rest_chest = _SK.fk(self.idle["bass"].rotations[0], self._roots[1])[0][CHEST]
         self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
         self.articulations: dict[int, str | None] = default_articulations()
+        # when each note became known (note_known), until its plan arrives; and the
+        # latest time posed so far: a note changes nothing at or before it
+        self._known: dict[tuple[str, int, int, float], float] = {}
+        self.drawn_until = -math.inf
 
     def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
         """The kit map's articulation per drum note number (``PlanConfig.kit.notes``):
@@ -214,11 +218,26 @@ class BandAnimator:
         s = self.settings
         return float(min(max(s.reference_spb / self.seconds_per_beat_at(time_s), 1.0), s.max_rate))
 
-    def add_planned(self, p: PlannedNoteLike) -> None:
+    def note_known(self, performer: str, note: Any, at_s: float) -> None:
+        """``note`` (a NoteOn) became known at ``at_s``, before it is planned: a
+        drummer's hand that is free may start toward it from then (see add_planned)."""
+        key = (performer, int(note.channel), int(note.note), round(float(note.time_s), 9))
+        self._known[key] = min(float(at_s), self._known.get(key, math.inf))
+
+    def add_planned(self, p: PlannedNoteLike, known_at: float | None = None) -> None:
         """Schedule the motions of one planned note (its start and impact are kept exactly).
+
+        A drummer's hand may change course for it from when the note became known
+        (``known_at``, else what :meth:`note_known` was told, else its ``start``), once
+        its previous stroke has landed, and never at or before a time already posed
+        (:attr:`drawn_until`): nothing drawn changes, live or offline.
 
         Raises :class:`UnknownMotionError` when the library lacks the motion.
         """
+        key = (p.performer, int(getattr(p, "channel", 0)), p.note, round(p.time, 9))
+        told = self._known.pop(key, None)
+        if known_at is None:
+            known_at = told
         rate = self._rate(p.impact)
         if p.performer == "drums":
             if not isinstance(p.motion, DrumStroke):
@@ -240,7 +259,9 @@ class BandAnimator:
             )
             self._hits.add(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
             art = self.articulations.get(p.note)
-            self.hands.add_stroke(limb, p.start, p.impact, clip, p.velocity, art)
+            course = p.start if known_at is None else min(known_at, p.start)
+            course = max(course, self.drawn_until)
+            self.hands.add_stroke(limb, course, p.impact, clip, p.velocity, art)
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
@@ -298,6 +319,7 @@ class BandAnimator:
             tl.forget_before(time_s)
         self.body.forget_before(time_s)
         self.hands.forget_before(time_s)
+        self._known = {k: v for k, v in self._known.items() if k[3] >= time_s - 10.0}
         self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
@@ -310,6 +332,7 @@ class BandAnimator:
 
     def local_rotations(self, time_s: float) -> np.ndarray:
         """Local rotations (2, n_joints, 4) of [drums, bass] at ``time_s``, w x y z."""
+        self.drawn_until = max(self.drawn_until, time_s)
         out = np.empty((2, _SK.n_joints, 4))
         nod = self._nod(time_s)
         for fi, f in enumerate(FIGURES):
@@ -408,6 +431,8 @@ class BandAnimator:
         ts = np.asarray(times, dtype=np.float64)
         if ts.ndim != 1 or (ts.size > 1 and np.any(np.diff(ts) < 0)):
             raise ValueError("times must be a 1-D array sorted ascending")
+        if ts.size:
+            self.drawn_until = max(self.drawn_until, float(ts[-1]))
         out = np.empty((ts.size, 2, _SK.n_joints, 4))
         nod = self._nod_many(ts)
         for fi, f in enumerate(FIGURES):

@@ -261,9 +261,11 @@ class DrummerHands:
     ) -> None:
         """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame.
 
-        The hand changes course for it no earlier than ``start`` (when a live session
-        learns of the note), so what was drawn before stays true.  ``articulation``
-        from the kit map: a side-stick lifts little, a rim shot fully.
+        ``start`` is the earliest time the hand may change course for it: when the note
+        became known and nothing later was drawn yet (:meth:`BandAnimator.add_planned`
+        gives that), so what was drawn before stays true; the hand also waits for its
+        previous impact.  ``articulation`` from the kit map: a side-stick lifts
+        little, a rim shot fully.
         """
         if hand not in self._times:
             return
@@ -336,8 +338,14 @@ class DrummerHands:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
             _add(pt, pv, pp, t, target, _SMOOTH)
             if prev_t is not None and cut <= prev_t:
-                # known at the last impact: the stick rebounds straight into the backswing
-                _add(lt, lv, lp, t - down, lift, _DECEL)
+                rebound = prev_t + min(s.rebound_max_s, s.rebound_share * gap)
+                if t - down - rise > rebound + 1e-4:
+                    # known by the last impact, time to spare: rebound, hover, rise
+                    _add(lt, lv, lp, rebound, min(s.hover_m, lift, prev_lift), _DECEL)
+                    _add(lt, lv, lp, t - down - rise, lv[-1], _SMOOTH)
+                    _add(lt, lv, lp, t - down, lift, _SMOOTH)
+                else:  # the stick rebounds straight into the backswing
+                    _add(lt, lv, lp, t - down, lift, _DECEL)
             else:
                 if t - down - rise > cut + 1e-4:
                     _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)

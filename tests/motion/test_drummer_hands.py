@@ -10,6 +10,7 @@ import pytest
 
 from tests.motion.helpers import drum
 from virja.errors import ConfigError
+from virja.events import NoteOn
 from virja.geometry import GEOMETRY
 from virja.motion.band import BandAnimator, sticks
 from virja.motion.clip import MotionLibrary
@@ -18,6 +19,7 @@ from virja.motion.drummer_hands import HandSettings
 from virja.motion.drummer_kit import default_articulations
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import SKELETON
+from virja.plan.types import PlannedNote
 
 HANDS_ON = HandSettings()
 PIECES = ("snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash")
@@ -189,3 +191,67 @@ def test_notes_arriving_at_their_start_change_nothing_already_drawn(library: Mot
             assert contact_distance(a, p, p.impact)[0] < 1e-4
     known, live_step = steps
     assert live_step <= known * 1.1 + 1e-3
+
+
+def _short_lead_notes() -> list[PlannedNote]:
+    """A right hand's first strokes from rest, each planned with a 60 ms lead (as at 300
+    bpm): hi-hat, then after a rest the ride, then the floor tom, crash after a gap."""
+    return [
+        drum("hihat_right_hand", 0.94, 1.0, 90),
+        drum("ride_right_hand", 4.94, 5.0, 90),
+        drum("tom_floor_right_hand", 5.34, 5.4, 90),
+        drum("crash_right_hand", 6.54, 6.6, 100),
+    ]
+
+
+def _known_at(p: PlannedNote) -> float:
+    return p.impact - 0.5  # read a beat ahead at 120 bpm
+
+
+def test_a_short_lead_known_a_beat_ahead_moves_from_when_the_note_is_known(
+    library: MotionLibrary,
+) -> None:
+    """The planned lead is 60 ms, too short to cross the kit, but the note was known
+    half a second ahead: the hand leaves in time, the wrist stays within 5 m/s and
+    moves at most 15 cm between 30 fps frames; without the known time it jumps."""
+    ts = np.arange(0.3, 7.0, 1 / 120)
+    peaks = []
+    for known in (True, False):
+        a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+        for p in _short_lead_notes():
+            a.add_planned(p, known_at=_known_at(p) if known else None)
+        w = _wrists(a, ts, "Right")
+        speed = np.linalg.norm(np.diff(w, axis=0), axis=1) * 120
+        jump = np.linalg.norm(w[4:] - w[:-4], axis=1).max()  # 4 frames at 120 = 1/30 s
+        peaks.append((speed.max(), jump))
+        for p in _short_lead_notes():
+            assert contact_distance(a, p, p.impact)[0] < 1e-4
+    (fast, jump_known), (slow, jump_late) = peaks
+    assert fast <= 5.0 and jump_known <= 0.15
+    assert slow > 8.0 and jump_late > 0.15  # the case this fixes
+
+
+def test_notes_known_early_but_planned_late_change_nothing_already_drawn(
+    library: MotionLibrary,
+) -> None:
+    """Live: a note becomes known (note_known) a beat ahead, its plan arrives at its
+    start while frames are being drawn.  Posed again afterwards, every frame drawn
+    equals what was drawn then (the hand turned from the state it was in), and the
+    contacts stay exact; the same notes all known in advance move sooner."""
+    notes = sorted(_short_lead_notes(), key=lambda p: p.start)
+    ts = np.arange(0.3, 7.0, 1 / 60)
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    drawn, told, k = [], 0, 0
+    for t in ts:
+        while told < len(notes) and _known_at(notes[told]) <= t:
+            n = notes[told]
+            a.note_known("drums", NoteOn(n.time, n.channel, n.note, n.velocity), t)
+            told += 1
+        while k < len(notes) and notes[k].start <= t:
+            a.add_planned(notes[k])
+            k += 1
+        drawn.append(a.local_rotations(float(t)))
+    again = a.local_rotations_many(ts)
+    np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
+    for p in notes:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4

@@ -116,16 +116,29 @@ class _Keys:
     lift_t: np.ndarray  # (L,)
     lift: np.ndarray  # (L,)
     lift_profile: np.ndarray  # (L,)
+    # where each segment would have ended had a later note not cut it short (_cut)
+    end_t: np.ndarray  # (K,)
+    end_rows: np.ndarray  # (K, 10): grip, rot, elbow
+    lift_end_t: np.ndarray  # (L,)
+    lift_end: np.ndarray  # (L,)
 
 
-def _shaped(keys_t: np.ndarray, profile: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(i0, i1, u): the segment of each time and the shaped fraction along it."""
+def _shaped(
+    keys_t: np.ndarray, profile: np.ndarray, t: np.ndarray, end_t: np.ndarray | None = None
+) -> tuple[np.ndarray, ...]:
+    """(i0, i1, u): the segment of each time and the shaped fraction along it.
+
+    ``end_t``: where each segment would have ended had it not been cut short (a key
+    put where a later note changed the course): the part before the cut keeps its
+    original curve, so what was drawn before stays exactly as it was."""
     n = keys_t.size
+    if end_t is None:
+        end_t = keys_t
     i1 = np.clip(np.searchsorted(keys_t, t, side="right"), 1, max(n - 1, 1))
     i0 = i1 - 1
     if n == 1:
         return np.zeros_like(i0), np.zeros_like(i0), np.zeros(t.shape)
-    span = keys_t[i1] - keys_t[i0]
+    span = end_t[i1] - keys_t[i0]
     ok = span > 1e-12
     u = np.where(ok, np.clip((t - keys_t[i0]) / np.where(ok, span, 1.0), 0.0, 1.0), 1.0)
     u = np.where(t < keys_t[0], 0.0, u)
@@ -156,26 +169,35 @@ def _lift_at(a: float, b: float, u: float) -> float:
 
 
 def _add(
-    times: list[float], values: list[Any], profiles: list[int], t: float, v: Any, p: int
+    times: list[float], values: list[Any], profiles: list[Any], t: float, v: Any, p: Any
 ) -> None:
     times.append(t)
     values.append(v)
     profiles.append(p)
 
 
-def _cut(times: list[float], values: list[Any], profiles: list[int], cut: float, at: Any) -> Any:
+def _segment(profile: Any, t: float, value: Any) -> tuple[int, float, Any]:
+    """(shape, end time, end value) of the segment ending at a key: its own unless the
+    key cut a segment short (then the tuple stored by :func:`_cut`)."""
+    return profile if isinstance(profile, tuple) else (profile, t, value)
+
+
+def _cut(times: list[float], values: list[Any], profiles: list[Any], cut: float, at: Any) -> Any:
     """The track's value at ``cut``; keys after ``cut`` are dropped and, unless one lies
-    exactly there, a key holding that value is put at ``cut`` (same segment shape)."""
+    exactly there, a key holding that value is put at ``cut`` that remembers the cut
+    segment's own end, so the track up to ``cut`` is unchanged."""
     k = bisect.bisect_right(times, cut)
+    prof: Any = _SMOOTH
     if k == 0:
         value = values[0]
     elif k == len(times):
         value = values[-1]
     else:
-        span = times[k] - times[k - 1]
-        u = 1.0 if span <= 1e-12 else _shape((cut - times[k - 1]) / span, profiles[k])
-        value = at(values[k - 1], values[k], u)
-    prof = profiles[k] if k < len(times) else _SMOOTH
+        shape, end_t, end_v = _segment(profiles[k], times[k], values[k])
+        span = end_t - times[k - 1]
+        u = 1.0 if span <= 1e-12 else _shape((cut - times[k - 1]) / span, shape)
+        value = at(values[k - 1], end_v, u)
+        prof = (shape, end_t, end_v)
     del times[k:], values[k:], profiles[k:]
     if not times or times[-1] < cut:
         _add(times, values, profiles, cut, value, prof)
@@ -307,10 +329,10 @@ class DrummerHands:
         assert rest is not None
         pt: list[float] = []  # pose keys: times, (grip, rot, elbow) rows, profiles
         pv: list[np.ndarray] = []
-        pp: list[int] = []
+        pp: list[Any] = []
         lt: list[float] = []  # lift keys
         lv: list[float] = []
-        lp: list[int] = []
+        lp: list[Any] = []
         prev_t: float | None = None
         prev_lift = 0.0
         for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
@@ -362,15 +384,21 @@ class DrummerHands:
             _add(pt, pv, pp, away + s.rest_move_s, home, _SMOOTH)
             prev_t, prev_lift = t, lift
         rows = np.array(pv)
+        seg = [_segment(*k) for k in zip(pp, pt, pv, strict=True)]
+        lseg = [_segment(*k) for k in zip(lp, lt, lv, strict=True)]
         return _Keys(
             np.array(pt),
             rows[:, :3],
             rows[:, 3:7],
             rows[:, 7:],
-            np.array(pp, dtype=np.int64),
+            np.array([g[0] for g in seg], dtype=np.int64),
             np.array(lt),
             np.array(lv),
-            np.array(lp, dtype=np.int64),
+            np.array([g[0] for g in lseg], dtype=np.int64),
+            np.array([g[1] for g in seg]),
+            np.array([g[2] for g in seg]),
+            np.array([g[1] for g in lseg]),
+            np.array([g[2] for g in lseg], dtype=np.float64),
         )
 
     def keys(self, hand: str) -> _Keys | None:
@@ -388,12 +416,13 @@ class DrummerHands:
         k = self.keys(hand)
         assert k is not None
         t = np.asarray(times, dtype=np.float64)
-        i0, i1, u = _shaped(k.t, k.profile, t)
-        grip = k.grip[i0] + u[:, None] * (k.grip[i1] - k.grip[i0])
-        elbow = k.elbow[i0] + u[:, None] * (k.elbow[i1] - k.elbow[i0])
-        rot = quat.slerp(k.rot[i0], k.rot[i1], u)
-        j0, j1, w = _shaped(k.lift_t, k.lift_profile, t)
-        lift = k.lift[j0] + w * (k.lift[j1] - k.lift[j0])
+        i0, i1, u = _shaped(k.t, k.profile, t, k.end_t)
+        end = k.end_rows[i1]
+        grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
+        elbow = k.elbow[i0] + u[:, None] * (end[:, 7:] - k.elbow[i0])
+        rot = quat.slerp(k.rot[i0], end[:, 3:7], u)
+        j0, j1, w = _shaped(k.lift_t, k.lift_profile, t, k.lift_end_t)
+        lift = k.lift[j0] + w * (k.lift_end[j1] - k.lift[j0])
         off = self._grip_off[hand]
         wrist = grip - quat.rotate(rot, off)
         # the stick turns up about the wrist, the wrist rises a share of the lift

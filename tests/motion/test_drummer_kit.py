@@ -66,3 +66,15 @@ def test_a_foot_chick_lets_the_foot_open_the_cymbals_just_before() -> None:
     assert 0.0 < h.chick_weight(1.9) < 1.0
     assert h.chick_weight(2.0) == 1.0
     assert h.chick_weight(2.9) == 0.0
+
+
+def test_a_closed_stroke_just_before_a_chick_lands_on_shut_cymbals() -> None:
+    """Bebop's ride-like hi-hat: open, closed 170 ms later, the foot's chick 170 ms
+    after that.  The foot lifts for the chick only after the closed stroke."""
+    h = HihatState()
+    h.add(0.0, "open")
+    h.add(0.17, "closed")
+    h.add(0.34, "pedal")
+    assert h.chick_weight(0.17) == 0.0
+    assert 0.0 < h.chick_weight(0.3) < 1.0
+    assert h.chick_weight(0.34) == 1.0

@@ -67,12 +67,19 @@ class HihatState:
 
     def chick_weight(self, t: float, window_s: float = 0.25) -> float:
         """0..1, rising over ``window_s`` to a pedal note's impact: how much the foot's own
-        lift opens the cymbals (a foot chick opens them a little and shuts them on the beat)."""
+        lift opens the cymbals (a foot chick opens them a little and shuts them on the beat).
+        The lift starts after the hi-hat note before the chick (0 at its impact), so a
+        closed stroke just before a chick still lands on shut cymbals."""
         i = bisect.bisect_left(self._pedal, t)
         if i == len(self._pedal):
             return 0.0
-        ahead = self._pedal[i] - t
-        return max(0.0, 1.0 - ahead / window_s)
+        at = self._pedal[i]
+        k = bisect.bisect_left(self._times, at) - 1  # the last hi-hat note before the chick
+        if k >= 0:
+            window_s = min(window_s, at - self._times[k])
+        if window_s <= 0.0:
+            return 0.0
+        return max(0.0, 1.0 - (at - t) / window_s)
 
     def forget_before(self, time_s: float) -> None:
         k = max(bisect.bisect_left(self._times, time_s - 10.0) - 1, 0)

@@ -140,7 +140,7 @@ def test_settings_load_and_errors(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="hands.toml"):
         HandSettings.load(bad)
     text = (Path(__file__).parents[2] / "motions" / "drummer_hands.toml").read_text()
-    bad.write_text(text.replace("speed_m_s = 2.5", "speed_m_s = 0"), encoding="utf-8")
+    bad.write_text(text.replace("speed_m_s = 2.0", "speed_m_s = 0"), encoding="utf-8")
     with pytest.raises(ConfigError, match="move.speed_m_s must be a number > 0"):
         HandSettings.load(bad)
 

@@ -50,6 +50,7 @@ HANDS = ("left_hand", "right_hand")
 _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
+_RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,7 @@ class HandSettings:
     down_max_s: float = 0.09
     rebound_share: float = 0.3
     rebound_max_s: float = 0.12
-    move_speed_m_s: float = 2.5
+    move_speed_m_s: float = 2.0
     rest_after_s: float = 2.0
     rest_move_s: float = 0.5
 
@@ -157,9 +158,17 @@ def _shape(u: float, profile: int) -> float:
     return u * u * (3 - 2 * u)
 
 
+def _height_share(u: np.ndarray, rise: np.ndarray) -> np.ndarray:
+    """How far along its move the grip's height is at shaped fraction ``u``: a hand going
+    up rises first, one going down stays up until late (over the cymbals' edges, not
+    under them); both still start and end at rest."""
+    return np.where(rise > 0, 1.0 - (1.0 - u) ** _RISE_LEAD, u**_DROP_LAG)
+
+
 def _pose_at(a: np.ndarray, b: np.ndarray, u: float) -> np.ndarray:
     """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u``."""
     out = a + u * (b - a)
+    out[1] = a[1] + float(_height_share(np.asarray(u), np.asarray(b[1] - a[1]))) * (b[1] - a[1])
     out[3:7] = quat.slerp(a[3:7], b[3:7], u)
     return out
 
@@ -419,6 +428,8 @@ class DrummerHands:
         i0, i1, u = _shaped(k.t, k.profile, t, k.end_t)
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
+        dy = end[:, 1] - k.grip[i0, 1]
+        grip[:, 1] = k.grip[i0, 1] + _height_share(u, dy) * dy
         elbow = k.elbow[i0] + u[:, None] * (end[:, 7:] - k.elbow[i0])
         rot = quat.slerp(k.rot[i0], end[:, 3:7], u)
         j0, j1, w = _shaped(k.lift_t, k.lift_profile, t, k.lift_end_t)

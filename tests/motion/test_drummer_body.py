@@ -113,3 +113,31 @@ def test_still_before_the_first_stroke(library: MotionLibrary) -> None:
     body = [i for i, n in enumerate(SKELETON.names) if n not in ("Neck", "Head")]  # idle nod
     assert np.abs(early[:, body] - early[0, body]).max() < 1e-12
     assert np.ptp(_chest_yaw(a, np.arange(9.5, 12.0, 0.05))) > 0.5
+
+
+def test_the_right_foot_feathers_the_kick_on_beats_without_a_kick(
+    library: MotionLibrary,
+) -> None:
+    """A ride pattern at 120 bpm, a kick on beat 3 only: the right toe presses down a
+    few millimetres on the other beats, not at all near the kick (exact contact)."""
+    from dataclasses import replace
+
+    from virja.motion.metrics import contact_distance
+
+    toe = SKELETON.index("RightToe")
+    kick = drum("kick_right_foot", 1.85, 2.0, velocity=90)
+    ys = []
+    for feather in (BodySettings().feather_deg, 0.0):
+        a = BandAnimator(library, body=replace(BodySettings(), feather_deg=feather))
+        for k in range(8):
+            a.add_beat(Beat(1.0 + 0.5 * k, k // 4, k % 4 + 1, 4, 0, 500_000))
+            a.add_planned(drum("ride_right_hand", 0.8 + 0.5 * k, 1.0 + 0.5 * k, velocity=70))
+        a.add_planned(kick)
+        ts = np.array([1.8, 1.9, 2.0, 2.1, 2.5, 2.75])
+        pos, _rot = SKELETON.fk(a.local_rotations_many(ts), a._roots)
+        ys.append(pos[:, 0, toe, 1])
+        assert contact_distance(a, kick, 2.0)[0] < 1e-4
+    feathered, flat = ys
+    np.testing.assert_allclose(feathered[:4], flat[:4], atol=1e-9)  # near the kick
+    assert feathered[4] < flat[4] - 0.005  # pressed on a free beat
+    assert abs(feathered[5] - flat[5]) < 1e-9  # and back between beats

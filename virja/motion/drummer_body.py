@@ -13,6 +13,9 @@ stay where the clips put them:
 - **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
   ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
   and the torso turns ``sway_deg`` one way on one beat, the other way on the next.
+- **feathered kick**: on each beat with no kick near it the right ankle presses
+  the kick's board a little (``feather_deg``, a cos^2 bump), as jazz drummers
+  feather the bass drum: the idle foot is never frozen.
 - **arms**: while a hand is playing (within ``engage_s`` of one of its
   impacts) each arm is re-solved as a two-bone chain from its moved shoulder
   to the wrist of the authored pose, elbow toward the authored elbow, and the
@@ -22,7 +25,8 @@ stay where the clips put them:
   the body: it breathes and sways instead of hanging frozen in space.
 
 Before the first hand stroke the drummer sits still (the body wakes over the
-``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals).  Constants:
+``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals; only the right
+ankle feathers).  Constants:
 motions/drummer_body.toml.  Everything is vectorised over times.
 """
 
@@ -44,6 +48,7 @@ _HIPS = _SK.index("Hips")
 _SPINE = _SK.index("Spine")
 _CHEST = _SK.index("Chest")
 _NECK = _SK.index("Neck")
+_RFOOT = _SK.index("RightFoot")
 _ARMS = {
     "left_hand": tuple(_SK.index(f"Left{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
     "right_hand": tuple(_SK.index(f"Right{j}") for j in ("Shoulder", "Arm", "ForeArm", "Hand")),
@@ -70,15 +75,20 @@ class BodySettings:
     reference_spb: float = 0.5
     engage_s: float = 1.0
     release_s: float = 0.5
+    feather_deg: float = 3.0
+    feather_width_s: float = 0.12
+    feather_clear_s: float = 0.3
 
     @classmethod
     def still(cls) -> BodySettings:
         """No body layer at all: the limbs exactly as the clips put them (for tests of the clips)."""
-        return cls(gain=0.0, breath_deg=0.0, beat_deg=0.0, sway_deg=0.0)
+        return cls(gain=0.0, breath_deg=0.0, beat_deg=0.0, sway_deg=0.0, feather_deg=0.0)
 
     @property
     def is_still(self) -> bool:
-        return self.gain == self.breath_deg == self.beat_deg == self.sway_deg == 0.0
+        return (
+            self.gain == self.breath_deg == self.beat_deg == self.sway_deg == self.feather_deg == 0
+        )
 
     @classmethod
     def load(cls, path: Path | None = None) -> BodySettings:
@@ -111,9 +121,13 @@ class DrummerBody:
             self.azimuth[name] = float(np.arctan2(d[0], d[2]))
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
         self._az: dict[str, list[float]] = {h: [] for h in HANDS}
+        self._kicks: list[float] = []  # the right foot's strokes (no feathering near them)
 
     def add_stroke(self, limb: str, impact: float, piece: str | None) -> None:
-        """Record a hand's stroke (feet and unknown pieces are ignored)."""
+        """Record a hand's stroke or a kick (the other foot and unknown pieces are ignored)."""
+        if limb == "right_foot":
+            bisect.insort(self._kicks, impact)
+            return
         if limb not in self._times or piece not in self.azimuth:
             return
         i = bisect.bisect_right(self._times[limb], impact)
@@ -126,6 +140,7 @@ class DrummerBody:
             k = max(bisect.bisect_left(self._times[h], horizon) - 1, 0)
             del self._times[h][:k]
             del self._az[h][:k]
+        del self._kicks[: max(bisect.bisect_left(self._kicks, horizon) - 1, 0)]
 
     # ------------------------------------------------------------------ curves
 
@@ -210,6 +225,32 @@ class DrummerBody:
 
     # ------------------------------------------------------------------ apply
 
+    def feather(self, t: np.ndarray, beat_times: np.ndarray) -> np.ndarray:
+        """The right ankle's press (rad, toe down) at ``t``: a feathered kick, a cos^2 bump
+        ``feather_width_s`` either side of each beat with no kick within ``feather_clear_s``
+        (the board moves, the beater barely leaves its rest; nothing sounds)."""
+        s = self.settings
+        if beat_times.size == 0 or s.feather_deg == 0.0:
+            return np.zeros(t.shape)
+        kicks = np.asarray(self._kicks, dtype=np.float64)
+        if kicks.size:
+            k = np.clip(np.searchsorted(kicks, beat_times), 1, kicks.size) - 1
+            near = np.minimum(
+                np.abs(kicks[k] - beat_times),
+                np.abs(kicks[np.minimum(k + 1, kicks.size - 1)] - beat_times),
+            )
+            free = near > s.feather_clear_s
+        else:
+            free = np.ones(beat_times.size, dtype=bool)
+        i = np.clip(np.searchsorted(beat_times, t), 1, beat_times.size) - 1
+        j = np.minimum(i + 1, beat_times.size - 1)
+        out = np.zeros(t.shape)
+        for b in (i, j):  # the beats either side: bumps are narrower than a beat
+            dt = np.abs(t - beat_times[b]) / s.feather_width_s
+            bump = np.where(dt < 1.0, np.cos(0.5 * np.pi * np.minimum(dt, 1.0)) ** 2, 0.0)
+            out = np.maximum(out, np.where(free[b], bump, 0.0))
+        return np.radians(s.feather_deg) * out
+
     def apply(
         self,
         times: np.ndarray,
@@ -243,6 +284,8 @@ class DrummerBody:
         chest_local = quat.multiply(chest_turn, quat.from_axis_angle(_SIDE, breath))
         out[:, _CHEST] = quat.multiply(chest_local, out[:, _CHEST])
         out[:, _NECK] = quat.multiply(quat.from_axis_angle(_UP, yaw * s.head_share), out[:, _NECK])
+        press = awake * self.feather(t, beat_times)
+        out[:, _RFOOT] = quat.multiply(out[:, _RFOOT], quat.from_axis_angle(_SIDE, press))
         # forward kinematics with world rotations as matrices; only the arms' converted
         p0, m0 = _SK.fk_matrices(local, root)
         p1, m1 = _SK.fk_matrices(out, root)

@@ -133,6 +133,9 @@ class BeatTable(Schema):
     sway_deg: float
     reference_spb: float
     sway_floor: float | None = None  # absent: BodySettings' default
+    feather_deg: float | None = None
+    feather_width_s: float | None = None
+    feather_clear_s: float | None = None
 
 
 class ArmsTable(Schema):
@@ -168,6 +171,15 @@ def body_settings(path: Path) -> BodySettings:
         reference_spb=f.beat.reference_spb,
         engage_s=f.arms.engage_s,
         release_s=f.arms.release_s,
+        **{
+            k: v
+            for k, v in (
+                ("feather_deg", f.beat.feather_deg),
+                ("feather_width_s", f.beat.feather_width_s),
+                ("feather_clear_s", f.beat.feather_clear_s),
+            )
+            if v is not None
+        },
     )
 
 

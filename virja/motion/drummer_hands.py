@@ -50,6 +50,7 @@ HANDS = ("left_hand", "right_hand")
 _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
+_MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
 _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
 
 
@@ -165,15 +166,16 @@ def _height_share(u: np.ndarray, rise: np.ndarray) -> np.ndarray:
     return np.where(rise > 0, 1.0 - (1.0 - u) ** _RISE_LEAD, u**_DROP_LAG)
 
 
-def _pose_at(a: np.ndarray, b: np.ndarray, u: float) -> np.ndarray:
-    """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u``."""
+def _pose_at(a: np.ndarray, b: np.ndarray, u: float, shape: int) -> np.ndarray:
+    """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u`` of a ``shape`` segment."""
     out = a + u * (b - a)
-    out[1] = a[1] + float(_height_share(np.asarray(u), np.asarray(b[1] - a[1]))) * (b[1] - a[1])
+    if shape == _MOVE:
+        out[1] = a[1] + float(_height_share(np.asarray(u), np.asarray(b[1] - a[1]))) * (b[1] - a[1])
     out[3:7] = quat.slerp(a[3:7], b[3:7], u)
     return out
 
 
-def _lift_at(a: float, b: float, u: float) -> float:
+def _lift_at(a: float, b: float, u: float, shape: int) -> float:
     return a + u * (b - a)
 
 
@@ -205,7 +207,7 @@ def _cut(times: list[float], values: list[Any], profiles: list[Any], cut: float,
         shape, end_t, end_v = _segment(profiles[k], times[k], values[k])
         span = end_t - times[k - 1]
         u = 1.0 if span <= 1e-12 else _shape((cut - times[k - 1]) / span, shape)
-        value = at(values[k - 1], end_v, u)
+        value = at(values[k - 1], end_v, u, shape)
         prof = (shape, end_t, end_v)
     del times[k:], values[k:], profiles[k:]
     if not times or times[-1] < cut:
@@ -345,6 +347,8 @@ class DrummerHands:
         prev_t: float | None = None
         prev_lift = 0.0
         for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
+            if prev_t is not None and t - prev_t < 1e-6:
+                continue  # two notes struck at once by one hand: one stroke
             target = np.concatenate([pose.grip, pose.rot, pose.elbow])
             if prev_t is None:
                 cut, gap = start, math.inf
@@ -367,11 +371,15 @@ class DrummerHands:
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
-            _add(pt, pv, pp, t, target, _SMOOTH)
-            if prev_t is not None and cut <= prev_t:
+                _add(pt, pv, pp, t, target, _MOVE)  # time enough: over the cymbals' edges
+            else:  # squeezed by the plan: the straight, shortest way
+                _add(pt, pv, pp, t, target, _SMOOTH)
+            rebound = -math.inf  # when the last stroke's rebound is over
+            if prev_t is not None:
                 rebound = prev_t + min(s.rebound_max_s, s.rebound_share * gap)
+            if cut < rebound - 1e-4:  # known before the last stroke's rebound is over
                 if t - down - rise > rebound + 1e-4:
-                    # known by the last impact, time to spare: rebound, hover, rise
+                    # time to spare: the rebound goes on to a hover, then the rise
                     _add(lt, lv, lp, rebound, min(s.hover_m, lift, prev_lift), _DECEL)
                     _add(lt, lv, lp, t - down - rise, lv[-1], _SMOOTH)
                     _add(lt, lv, lp, t - down, lift, _SMOOTH)
@@ -390,7 +398,7 @@ class DrummerHands:
             _add(lt, lv, lp, away + s.rest_move_s, 0.0, _SMOOTH)
             _add(pt, pv, pp, away, target, _SMOOTH)
             home = np.concatenate([rest.grip, rest.rot, rest.elbow])
-            _add(pt, pv, pp, away + s.rest_move_s, home, _SMOOTH)
+            _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
             prev_t, prev_lift = t, lift
         rows = np.array(pv)
         seg = [_segment(*k) for k in zip(pp, pt, pv, strict=True)]
@@ -429,7 +437,8 @@ class DrummerHands:
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
         dy = end[:, 1] - k.grip[i0, 1]
-        grip[:, 1] = k.grip[i0, 1] + _height_share(u, dy) * dy
+        moving = k.profile[i1] == _MOVE
+        grip[:, 1] = np.where(moving, k.grip[i0, 1] + _height_share(u, dy) * dy, grip[:, 1])
         elbow = k.elbow[i0] + u[:, None] * (end[:, 7:] - k.elbow[i0])
         rot = quat.slerp(k.rot[i0], end[:, 3:7], u)
         j0, j1, w = _shaped(k.lift_t, k.lift_profile, t, k.lift_end_t)

@@ -255,3 +255,19 @@ def test_notes_known_early_but_planned_late_change_nothing_already_drawn(
     np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
     for p in notes:
         assert contact_distance(a, p, p.impact)[0] < 1e-4
+
+
+def test_a_note_known_at_the_last_impact_lets_the_stick_rebound_first(
+    library: MotionLibrary,
+) -> None:
+    """Ride strokes half a second apart, the next one known just after each impact:
+    the stick rebounds off the cymbal at once (no sitting on it), contacts exact."""
+    notes = [drum("ride_right_hand", 0.9 + 0.5 * k, 1.0 + 0.5 * k, 80) for k in range(4)]
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    for k, p in enumerate(notes):
+        a.add_planned(p, known_at=notes[k - 1].impact + 1e-9 if k else p.start)
+    ride = GEOMETRY.kit.pieces["ride"]
+    for p in notes[:-1]:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4
+        h = (_tips(a, np.array([p.impact + 0.03]))[:, 1] - ride.centre) @ ride.normal
+        assert h[0] > 0.005  # off the cymbal 30 ms after the impact

@@ -91,3 +91,21 @@ def test_motion_report_json_gives_every_figure(
     assert d["notes"] == 5 and d["routed_to_nobody"] == {"Open Hi Conga": 1}
     assert d["contact_max_mm"] < 10.0
     assert d["dropped"] == {}
+
+
+def test_an_open_hihat_at_the_instant_of_the_pedal_is_counted_apart(
+    library: MotionLibrary,
+) -> None:
+    """MMA's swing writes the open hi-hat (46) at the instant of the pedal (44): no
+    pair of cymbals is both; those two notes are counted apart, the rest agree."""
+    notes = [("drums", NoteOn(1.0 + 0.5 * i, 9, 42, 80)) for i in range(4)]
+    notes += [("drums", NoteOn(3.0, 9, 46, 80)), ("drums", NoteOn(3.0, 9, 44, 70))]
+    planned = plan_notes(notes, ConstantTempo(0.5))  # type: ignore[arg-type]
+    a = BandAnimator(library)
+    for p in planned:
+        a.add_planned(p)
+    kit = default_config().kit
+    fig = measure_drummer(a, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=60)
+    assert fig.hihat_contradictory == 2
+    assert fig.hihat_notes == 4 and fig.hihat_agreement == 1.0
+    assert fig.to_json()["hihat_contradictory"] == 2

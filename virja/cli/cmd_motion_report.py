@@ -279,7 +279,12 @@ def _drummer_table(rep: MotionReport, drummer: DrummerFigures, drops: Counter[st
         ),
         (
             "hi-hat agreement",
-            "-" if agree is None else f"{agree * 100:.1f} % of {drummer.hihat_notes}",
+            ("-" if agree is None else f"{agree * 100:.1f} % of {drummer.hihat_notes}")
+            + (
+                f" ({drummer.hihat_contradictory} more with a note of the other state at once)"
+                if drummer.hihat_contradictory
+                else ""
+            ),
             "100 %",
             agree is None or agree >= 1.0,
         ),

@@ -16,7 +16,10 @@ Sampled from a :class:`~virja.motion.band.BandAnimator` over a time span:
 - **hi-hat agreement**: the share of hi-hat notes whose cymbals are where the
   note says at its impact: closed (and pedal) notes closed (openness <= 0.15),
   open notes open (openness >= 0.3).  Articulations come from the caller (the
-  kit map), as note number -> articulation.
+  kit map), as note number -> articulation.  A note with a note of the other
+  state within 30 ms (MMA writes an open hi-hat, 46, at the instant of the
+  pedal, 44: no pair of cymbals can be both) is counted apart, in
+  ``hihat_contradictory``, not in the share.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ _SK = SKELETON
 STICK_RADIUS_M = 0.007
 PENETRATION_M = 0.005
 CLOSED_MAX = 0.15
+CONTRADICTION_S = 0.03  # the planner's grouping window: notes meant together
 OPEN_MIN = 0.3
 HAND_JOINTS = ("LeftHand", "RightHand")
 LEG_SEGMENTS = (("LeftUpLeg", "LeftLeg"), ("LeftLeg", "LeftFoot"))
@@ -62,6 +66,7 @@ class DrummerFigures:
     collisions: dict[str, int] = field(default_factory=dict)
     hihat_notes: int = 0
     hihat_agreeing: int = 0
+    hihat_contradictory: int = 0  # notes with one of the other state within 30 ms
 
     @property
     def hihat_agreement(self) -> float | None:
@@ -75,6 +80,7 @@ class DrummerFigures:
             "torso_range_deg": round(self.torso_range_deg, 2),
             "collisions": dict(sorted(self.collisions.items())),
             "hihat_notes": self.hihat_notes,
+            "hihat_contradictory": self.hihat_contradictory,
             "hihat_agreement": (
                 None if self.hihat_agreement is None else round(self.hihat_agreement, 4)
             ),
@@ -189,12 +195,21 @@ def measure_drummer(
     yaw = _yaw_deg(rot[:, _SK.index("Chest")])
     fig.torso_range_deg = float(yaw.max() - yaw.min())
     fig.collisions = _collisions(animator, pos, stk)
+    states = [  # (impact, wants closed) of every articulated hi-hat note
+        (p.impact, articulation.get(p.note) in CLOSED_ARTICULATIONS)
+        for p in drums
+        if p.piece == "hihat"
+        and articulation.get(p.note) in CLOSED_ARTICULATIONS | OPEN_ARTICULATIONS
+    ]
     for p in drums:
         art = articulation.get(p.note)
         if p.piece != "hihat" or art is None:
             continue
         want_closed = art in CLOSED_ARTICULATIONS
         if not want_closed and art not in OPEN_ARTICULATIONS:
+            continue
+        if any(abs(t - p.impact) <= CONTRADICTION_S and c != want_closed for t, c in states):
+            fig.hihat_contradictory += 1
             continue
         wpos, _w = _SK.fk(animator.local_rotations(p.impact), animator._roots)
         openness = animator._hihat_open(wpos[0], p.impact)

@@ -159,18 +159,20 @@ def _shape(u: float, profile: int) -> float:
     return u * u * (3 - 2 * u)
 
 
-def _height_share(u: np.ndarray, rise: np.ndarray) -> np.ndarray:
+def _height_share(u: np.ndarray, rise: np.ndarray, moving: np.ndarray) -> np.ndarray:
     """How far along its move the grip's height is at shaped fraction ``u``: a hand going
-    up rises first, one going down stays up until late (over the cymbals' edges, not
-    under them); both still start and end at rest."""
-    return np.where(rise > 0, 1.0 - (1.0 - u) ** _RISE_LEAD, u**_DROP_LAG)
+    down stays up until late (off a cymbal over its edge, not under it); on a move
+    given its full time (``moving``) a hand going up also rises first; all start and
+    end at rest."""
+    lead = np.where(moving, 1.0 - (1.0 - u) ** _RISE_LEAD, u)
+    return np.where(rise > 0, lead, u**_DROP_LAG)
 
 
 def _pose_at(a: np.ndarray, b: np.ndarray, u: float, shape: int) -> np.ndarray:
     """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u`` of a ``shape`` segment."""
     out = a + u * (b - a)
-    if shape == _MOVE:
-        out[1] = a[1] + float(_height_share(np.asarray(u), np.asarray(b[1] - a[1]))) * (b[1] - a[1])
+    dy = np.asarray(b[1] - a[1])
+    out[1] = a[1] + float(_height_share(np.asarray(u), dy, np.asarray(shape == _MOVE))) * dy
     out[3:7] = quat.slerp(a[3:7], b[3:7], u)
     return out
 
@@ -437,8 +439,7 @@ class DrummerHands:
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
         dy = end[:, 1] - k.grip[i0, 1]
-        moving = k.profile[i1] == _MOVE
-        grip[:, 1] = np.where(moving, k.grip[i0, 1] + _height_share(u, dy) * dy, grip[:, 1])
+        grip[:, 1] = k.grip[i0, 1] + _height_share(u, dy, k.profile[i1] == _MOVE) * dy
         elbow = k.elbow[i0] + u[:, None] * (end[:, 7:] - k.elbow[i0])
         rot = quat.slerp(k.rot[i0], end[:, 3:7], u)
         j0, j1, w = _shaped(k.lift_t, k.lift_profile, t, k.lift_end_t)

@@ -69,6 +69,7 @@ def test_frames_are_posed_ahead_and_a_late_note_is_in_the_next_frame() -> None:
     assert loop.step()
     pose, scene = window.frames[-1]
     told = BandAnimator()
+    told.mark_drawn(window.frames[-2][0].time_s)  # shown before the note came: kept
     told.add_planned(note)
     assert _same(pose, scene, told.pose(pose.time_s))  # drawn with the stroke
     assert not _same(pose, scene, BandAnimator().pose(pose.time_s))  # which shows

@@ -251,6 +251,7 @@ def test_notes_known_early_but_planned_late_change_nothing_already_drawn(
             a.add_planned(notes[k])
             k += 1
         drawn.append(a.local_rotations(float(t)))
+        a.mark_drawn(float(t))
     again = a.local_rotations_many(ts)
     np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
     for p in notes:

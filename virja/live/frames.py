@@ -24,9 +24,10 @@ AHEAD_FRAMES = 6  # the band is posed for this many slots at once (thrown away o
 
 
 def _changes_pose(animator: Any, item: tuple[Any, ...]) -> bool:
-    """Whether an inbox item may change the animator's poses (chords, the clock and a
-    drum's note-off do not: ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
-    if item[0] in ("chord", "clock", "stop"):
+    """Whether an inbox item may change the animator's poses (chords, the clock, a
+    note's arrival before its plan and a drum's note-off do not:
+    ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
+    if item[0] in ("chord", "clock", "stop", "known"):
         return False
     if item[0] == "off":
         return item[1] in getattr(animator, "NOTE_OFF_PERFORMERS", (item[1],))
@@ -160,6 +161,9 @@ class FrameLoop:
                 show_frame(pose, scene)  # the window: the instances built with the chunk
             else:
                 s.show(pose)
+        mark = getattr(self.animator, "mark_drawn", None)
+        if mark is not None:  # shown: a note learnt later changes nothing up to here
+            mark(pose.time_s)
         self.pacer.drawn(started, self.monotonic())
         if self.pacer.shown % FORGET_EVERY == 0:
             self.animator.forget_before(self.anchor_s + started - KEEP_MOTION_S)

@@ -175,7 +175,7 @@ class BandAnimator:
         self.hihat = HihatState(self.settings.hihat_lead_s, self.settings.hihat_hold_open_s)
         self.articulations: dict[int, str | None] = default_articulations()
         # when each note became known (note_known), until its plan arrives; and the
-        # latest time posed so far: a note changes nothing at or before it
+        # latest frame shown (mark_drawn): a note changes nothing at or before it
         self._known: dict[tuple[str, int, int, float], float] = {}
         self.drawn_until = -math.inf
 
@@ -218,6 +218,12 @@ class BandAnimator:
         s = self.settings
         return float(min(max(s.reference_spb / self.seconds_per_beat_at(time_s), 1.0), s.max_rate))
 
+    def mark_drawn(self, time_s: float) -> None:
+        """A frame of ``time_s`` was shown (the live window, the web feed, a single
+        :meth:`pose`): a note planned later changes nothing at or before it.  Frames
+        posed ahead and thrown away, and measurements, are not marked."""
+        self.drawn_until = max(self.drawn_until, float(time_s))
+
     def note_known(self, performer: str, note: Any, at_s: float) -> None:
         """``note`` (a NoteOn) became known at ``at_s``, before it is planned: a
         drummer's hand that is free may start toward it from then (see add_planned)."""
@@ -229,8 +235,8 @@ class BandAnimator:
 
         A drummer's hand may change course for it from when the note became known
         (``known_at``, else what :meth:`note_known` was told, else its ``start``), once
-        its previous stroke has landed, and never at or before a time already posed
-        (:attr:`drawn_until`): nothing drawn changes, live or offline.
+        its previous stroke has landed, and never at or before a frame already shown
+        (:attr:`drawn_until`, :meth:`mark_drawn`): nothing drawn changes.
 
         Raises :class:`UnknownMotionError` when the library lacks the motion.
         """
@@ -332,7 +338,6 @@ class BandAnimator:
 
     def local_rotations(self, time_s: float) -> np.ndarray:
         """Local rotations (2, n_joints, 4) of [drums, bass] at ``time_s``, w x y z."""
-        self.drawn_until = max(self.drawn_until, time_s)
         out = np.empty((2, _SK.n_joints, 4))
         nod = self._nod(time_s)
         for fi, f in enumerate(FIGURES):
@@ -400,7 +405,8 @@ class BandAnimator:
         )
 
     def pose(self, time_s: float) -> BandPose:
-        """The band at ``time_s`` (session seconds)."""
+        """The band at ``time_s`` (session seconds), a frame shown (:meth:`mark_drawn`)."""
+        self.mark_drawn(time_s)
         loc = self.local_rotations(time_s)
         wpos, wrot = _SK.fk(loc, self._roots)
         lean, fingers = self._bass_parts(time_s, wpos[1], self.bass_transform(wpos[1]))
@@ -431,8 +437,6 @@ class BandAnimator:
         ts = np.asarray(times, dtype=np.float64)
         if ts.ndim != 1 or (ts.size > 1 and np.any(np.diff(ts) < 0)):
             raise ValueError("times must be a 1-D array sorted ascending")
-        if ts.size:
-            self.drawn_until = max(self.drawn_until, float(ts[-1]))
         out = np.empty((ts.size, 2, _SK.n_joints, 4))
         nod = self._nod_many(ts)
         for fi, f in enumerate(FIGURES):

@@ -268,6 +268,9 @@ class _Deferred:
     def note_off(self, performer: object, event: object) -> None:
         self.calls.append(("note_off", (performer, event)))
 
+    def note_known(self, performer: object, note: object, at_s: float) -> None:
+        self.calls.append(("note_known", (performer, note, at_s)))
+
     def set_articulations(self, articulations: object) -> None:
         self.calls.append(("set_articulations", (articulations,)))
 
@@ -313,9 +316,11 @@ class _Ahead:
             self.news.append(calls)
 
     def _changes_pose(self, call: _Call) -> bool:
-        """Whether a call may change the animator's poses (a drum's note-off does not:
-        ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
+        """Whether a call may change the animator's poses (a note's arrival before its
+        plan and a drum's note-off do not: ``BandAnimator.NOTE_OFF_PERFORMERS``)."""
         name, args = call
+        if name == "note_known":
+            return False
         if name != "note_off":
             return True
         return args[0] in getattr(self.animator, "NOTE_OFF_PERFORMERS", (args[0],))
@@ -340,6 +345,9 @@ class _Ahead:
             while j < len(self.news) and not self.news[j]:
                 j += 1
             self.chunks.prepare(self.times[i:j])
+        mark = getattr(self.animator, "mark_drawn", None)
+        if mark is not None:  # drawn: news told later changes nothing up to here
+            mark(t)
         return self.chunks.scene(t)
 
     def close(self) -> None:

@@ -30,3 +30,19 @@ def test_frame_matches_golden_image(name: str, tmp_path: Path) -> None:
     diff = np.abs(got - want).max(axis=2)
     assert diff.mean() < 0.25, diff.mean()
     assert (diff > 48).mean() < 0.001, (diff > 48).mean()  # 80 ms of motion fails this
+
+
+def test_as_live_draws_what_the_window_knew_then(tmp_path: Path) -> None:
+    """`render --as-live`: each frame knows only the motions started by its time, as
+    the live window; at 6.932 s of the demo the drummer's hands are elsewhere than in
+    the default render (which knows the whole input), and nowhere else differs."""
+    from virja.cli.main import main
+
+    def frame(*extra: str) -> np.ndarray:
+        out = tmp_path / f"f{len(extra)}.png"
+        argv = ["render", str(REPO / "virja/demo/blues.mid"), "--out", str(out), "--at", "6.932"]
+        assert main([*argv, "--camera", "drums", "--size", "192x108", *extra]) == 0
+        return decode_png_rgb(out.read_bytes()).astype(int)
+
+    moved = (np.abs(frame("--as-live") - frame()).max(axis=2) > 48).mean()
+    assert 0.001 < moved < 0.05, moved

@@ -51,3 +51,29 @@ def test_chunked_frames_equal_the_plain_loop(path: Path) -> None:
     assert ahead.chunks.chunks < len(times) / 2  # in stretches of frames, not one by one
     with pytest.raises(ValueError, match="in order"):
         ahead.scene(times[0])
+
+
+@pytest.mark.parametrize("path", [DEMO_MID, GMD_TAKE], ids=["demo", "gmd"])
+def test_by_default_every_frame_is_drawn_knowing_the_whole_input(path: Path) -> None:
+    """`virja render` (not --as-live): the whole input played through first, then
+    posed 30 frames at a time; each frame is what motion-report and export measure
+    (pipeline.perform's animator), the plan is the same."""
+    from virja.pipeline import perform
+    from virja.render.offline import _Whole
+
+    if not path.is_file():
+        pytest.skip(f"{path} not here")
+    settings = PerformanceSettings()
+    src = load_performance_input(path, settings.routing)
+    t0, _ = src.default_span()
+    times = list(frame_times(t0, t0 + 6.0, 30.0))
+    known, planned = perform(settings, src, animate=True)
+    want = [band_scene(known.pose(t)) for t in times]
+    drawn = build_performance(settings, src, animate=True)
+    whole = _Whole(drawn, RevealFeeder(src.schedule), times, 30)
+    for t, w in zip(times, want, strict=True):
+        got = whole.scene(t)
+        for kind in ("box", "cylinder", "sphere"):
+            assert np.allclose(got.packed(kind), w.packed(kind), rtol=0, atol=1e-6), (t, kind)
+    assert [p.to_log_json(0.0) for p in drawn.planned] == [p.to_log_json(0.0) for p in planned]
+    assert whole.chunks.chunks == -(-len(times) // 30)  # 30 frames a chunk (as asked)

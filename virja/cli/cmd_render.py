@@ -118,6 +118,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--plan-log", metavar="FILE.jsonl", help="also write the plan, one JSON object per note"
     )
     p.add_argument(
+        "--as-live",
+        action="store_true",
+        help="draw each frame knowing only what the live window would know at its time "
+        "(motions learned as they start); default: the whole input known, as motion-report "
+        "and export see it",
+    )
+    p.add_argument(
         "--bvh",
         metavar="OUT.bvh",
         help="also write the band's performed motion as OUT_drums.bvh and OUT_bass.bvh "
@@ -175,6 +182,7 @@ def render_request(
         fps=args.fps,
         samples=args.samples,
         hud=bool(getattr(args, "hud", False)),
+        as_live=bool(getattr(args, "as_live", False)),
         progress=ProgressBar("rendering") if out.kind != "png" or at is None else None,
     )
     return RenderRequest(

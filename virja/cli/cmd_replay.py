@@ -65,6 +65,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--out", metavar="OUT", help="render to a video (.mp4/.mkv/.mov), a folder or NAME.png"
     )
+    p.add_argument(
+        "--as-live",
+        action="store_true",
+        help="with --out: draw each frame knowing only what the live window would know at its time "
+        "(motions learned as they start); default: the whole input known, as motion-report "
+        "and export see it",
+    )
     p.add_argument("--size", default="1280x720", metavar="WxH")
     p.add_argument("--fps", type=finite_float, default=30.0)
     p.add_argument("--camera", choices=sorted(PRESETS), default="front")

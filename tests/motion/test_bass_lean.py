@@ -91,3 +91,22 @@ def test_the_instrument_is_drawn_where_the_pose_leans_it(
     boxes_moved = np.concatenate(moved.models["box"])[-n:]
     assert np.allclose(boxes_moved, pose.bass_transform @ boxes_still)
     assert not np.allclose(boxes_moved, boxes_still, atol=1e-3)
+
+
+@pytest.mark.parametrize(("bpm", "half"), [(120, False), (150, False), (160, True), (300, True)])
+def test_over_150_bpm_the_body_moves_in_half_time(
+    library: MotionLibrary, bpm: int, half: bool
+) -> None:
+    """The weight and the dip go with every beat up to 150 bpm and with every other
+    beat above it (a player at 300 bpm does not bob five times a second); the weight
+    is still on a foot at a beat."""
+    a = BandAnimator(library)
+    spb = 60.0 / bpm
+    for i in range(16):
+        a.add_beat(Beat(spb * i, i // 4, i % 4 + 1, 4, 2, round(spb * 1e6)))
+    t = spb * np.array([4.0, 4.5, 5.0, 5.5, 6.0])
+    index, phase = a._body_pulse(t, *a._beat_phase_many(t))
+    if half:
+        assert index.tolist() == [2, 2, 2, 2, 3] and np.allclose(phase, [0, 0.25, 0.5, 0.75, 0])
+    else:
+        assert index.tolist() == [4, 4, 5, 5, 6] and np.allclose(phase, [0, 0.5, 0, 0.5, 0])

@@ -194,7 +194,7 @@ def _compare(animator: BandAnimator, times: np.ndarray) -> None:
     moved = 0
     for k, t in enumerate(times.tolist()):
         # the clips' pose before the body: rebuild it as local_rotations does
-        index, phase = animator._beat_phase(t)
+        index, phase = animator._pulse_at(t)
         pre = _clips_only(animator, t)
         want = plain_body(animator.bassist, pre, animator._roots[1], t, phase, index)
         assert _same_up_to_sign(loc[k, 1], want) < 1e-12, f"t={t}"

@@ -355,7 +355,7 @@ class BandAnimator:
                 elif len(tl):
                     loc[tl.joint_index] = tl.blend(time_s, loc[tl.joint_index])
         out[0] = self._body(np.array([time_s]), out[None, 0])[0]
-        index, phase = self._beat_phase(time_s)
+        index, phase = self._pulse_at(time_s)
         out[1] = self.bassist.body(out[1], self._roots[1], time_s, phase, index)
         return out
 
@@ -363,17 +363,6 @@ class BandAnimator:
         """Whether the drummer's ``limb`` moves from where it is (virja.motion.drummer_hands)
         rather than by its time-warped clips."""
         return self.hands.enabled and self.hands.has_strokes(limb)
-
-    def _beat_phase(self, t: float) -> tuple[int, float]:
-        """(beat number, phase 0..1 within it) at ``t`` (120 bpm before the first beat)."""
-        i = bisect.bisect_right(self._beat_times, t) - 1
-        if i >= 0:
-            phase = (t - self._beat_times[i]) / self._beat_spb[i]
-            if phase < 1.0:
-                return i, phase
-            return i + int(phase), phase % 1.0
-        spb = self.settings.reference_spb
-        return int(math.floor(t / spb)), (t / spb) % 1.0
 
     def _body(self, times: np.ndarray, drummer: np.ndarray) -> np.ndarray:
         """The drummer's living body over the limbs (virja.motion.drummer_body)."""
@@ -451,12 +440,37 @@ class BandAnimator:
                 elif len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
         out[:, 0] = self._body(ts, out[:, 0])
-        index, phase = self._beat_phase_many(ts)
+        index, phase = self._body_pulse(ts, *self._beat_phase_many(ts))
         out[:, 1] = self.bassist.body_many(out[:, 1], self._roots[1], ts, phase, index)
         return out
 
+    def _pulse_at(self, t: float) -> tuple[int, float]:
+        """:meth:`_body_pulse` at one time: (pulse number, phase)."""
+        ts = np.array([t])
+        index, phase = self._body_pulse(ts, *self._beat_phase_many(ts))
+        return int(index[0]), float(phase[0])
+
+    def _body_pulse(
+        self, t: np.ndarray, index: np.ndarray, phase: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The bassist's body pulse (numbers, phases) from the beat's: the beat itself,
+        or every other beat where beats are shorter than ``half_time_spb`` (half time
+        over 150 bpm: his weight and dip at half the rate)."""
+        bt = np.asarray(self._beat_times, dtype=np.float64)
+        spb = np.full(t.shape, self.settings.reference_spb)
+        if bt.size:
+            i = np.searchsorted(bt, t, side="right") - 1
+            beat_spb = np.asarray(self._beat_spb, dtype=np.float64)
+            spb = np.where(i >= 0, beat_spb[np.maximum(i, 0)], spb)
+        half = spb < self.bassist.settings.half_time_spb
+        return (
+            np.where(half, index // 2, index),
+            np.where(half, (index % 2 + phase) / 2.0, phase),
+        )
+
     def _beat_phase_many(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`_beat_phase` over an array of times: (beat numbers, phases)."""
+        """(beat numbers, phases 0..1 within them) at times ``t`` (120 bpm before the
+        first beat)."""
         bt = np.asarray(self._beat_times, dtype=np.float64)
         i = np.searchsorted(bt, t, side="right") - 1
         spb_ref = self.settings.reference_spb

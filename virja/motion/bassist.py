@@ -67,6 +67,7 @@ class BassistSettings:
     sway_rad: float = 0.03  # hips: weight from foot to foot over two beats, on a foot at a beat
     dip_rad: float = 0.035  # spine: forward with each beat...
     dip_after_beat: float = 0.12  # ...deepest this share of a beat after it
+    half_time_spb: float = 0.4  # beats shorter than this (over 150 bpm): the body in half time
     body_ramp_s: float = 0.4  # the body's motion grows over this before a note after a rest
     turn_rad_per_m: float = 0.25  # chest: toward the fretting hand, per metre down the neck
     shoulder_slack_m: float = 0.42  # the fretting shoulder reaches toward a wrist farther...

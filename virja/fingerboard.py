@@ -35,7 +35,7 @@ class BoardSpec:
     margin_nut_m: float = 0.006
     margin_end_m: float = 0.012
     end_share: float = 0.78
-    face_m: float = -0.004
+    face_m: float = -0.006  # the strings stand 6 mm over it (an upright's action: 5-10 mm)
     thickness_m: float = 0.014
     back_m: float = -0.030
 

@@ -31,3 +31,10 @@ def shaders_dir() -> Path:
 def motions_dir() -> Path:
     """The folder of basic-motion data and cost tables (TOML, BVH)."""
     return _data_dir("motions")
+
+
+def motions_file(name: str, path: Path | None = None) -> Path | None:
+    """``path``, else motions/``name``; None when that file is absent (the caller's
+    defaults then stand)."""
+    found = motions_dir() / name if path is None else path
+    return found if found.is_file() else None

@@ -253,6 +253,13 @@ class RevealFeeder:
     def done(self) -> bool:
         return self.next >= len(self.schedule)
 
+    def finish(self, perf: Performance) -> list[PlannedNote]:
+        """Everything not fed yet, played through on the virtual clock
+        (:func:`run_schedule`); the performance finished."""
+        rest = self.schedule[self.next :]
+        self.next = len(self.schedule)
+        return run_schedule(perf, rest)
+
 
 def run_schedule(perf: Performance, schedule: list[Reveal]) -> list[PlannedNote]:
     """Play a whole reveal schedule on a virtual clock as fast as possible.

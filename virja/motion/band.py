@@ -129,14 +129,10 @@ class AnimationSettings:
         """motions/animation.toml (or ``path``); the defaults when the file is absent.
         Its schema: :class:`virja.motion.settings_files.AnimationFile`."""
         from virja.motion.settings_files import animation_settings
+        from virja.resources import motions_file
 
-        if path is None:
-            from virja.resources import motions_dir
-
-            path = motions_dir() / "animation.toml"
-        if not path.is_file():
-            return cls()
-        return animation_settings(path)
+        found = motions_file("animation.toml", path)
+        return cls() if found is None else animation_settings(found)
 
 
 class BandAnimator:
@@ -440,49 +436,43 @@ class BandAnimator:
                 elif len(tl):
                     loc[:, tl.joint_index] = blend_many(tl, ts, loc[:, tl.joint_index])
         out[:, 0] = self._body(ts, out[:, 0])
-        index, phase = self._body_pulse(ts, *self._beat_phase_many(ts))
+        index, phase = self._body_pulse(ts)
         out[:, 1] = self.bassist.body_many(out[:, 1], self._roots[1], ts, phase, index)
         return out
 
     def _pulse_at(self, t: float) -> tuple[int, float]:
         """:meth:`_body_pulse` at one time: (pulse number, phase)."""
-        ts = np.array([t])
-        index, phase = self._body_pulse(ts, *self._beat_phase_many(ts))
+        index, phase = self._body_pulse(np.array([t]))
         return int(index[0]), float(phase[0])
 
-    def _body_pulse(
-        self, t: np.ndarray, index: np.ndarray, phase: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The bassist's body pulse (numbers, phases) from the beat's: the beat itself,
+    def _body_pulse(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The bassist's body pulse (numbers, phases) at times ``t``: the beat itself,
         or every other beat where beats are shorter than ``half_time_spb`` (half time
         over 150 bpm: his weight and dip at half the rate)."""
-        bt = np.asarray(self._beat_times, dtype=np.float64)
-        spb = np.full(t.shape, self.settings.reference_spb)
-        if bt.size:
-            i = np.searchsorted(bt, t, side="right") - 1
-            beat_spb = np.asarray(self._beat_spb, dtype=np.float64)
-            spb = np.where(i >= 0, beat_spb[np.maximum(i, 0)], spb)
+        index, phase, spb = self._beat_phase_many(t)
         half = spb < self.bassist.settings.half_time_spb
         return (
             np.where(half, index // 2, index),
             np.where(half, (index % 2 + phase) / 2.0, phase),
         )
 
-    def _beat_phase_many(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(beat numbers, phases 0..1 within them) at times ``t`` (120 bpm before the
-        first beat)."""
+    def _beat_phase_many(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(beat numbers, phases 0..1 within them, seconds per beat) at times ``t``
+        (120 bpm before the first beat)."""
         bt = np.asarray(self._beat_times, dtype=np.float64)
         i = np.searchsorted(bt, t, side="right") - 1
         spb_ref = self.settings.reference_spb
         index = np.floor(t / spb_ref).astype(np.int64)
         phase = np.mod(t / spb_ref, 1.0)
+        spb = np.full(t.shape, spb_ref)
         if bt.size:
             k = np.maximum(i, 0)
-            p = (t - bt[k]) / np.asarray(self._beat_spb, dtype=np.float64)[k]
+            spb = np.where(i >= 0, np.asarray(self._beat_spb, dtype=np.float64)[k], spb)
+            p = (t - bt[k]) / spb
             whole = np.floor(p).astype(np.int64)
             index = np.where(i >= 0, np.where(p < 1.0, k, k + whole), index)
             phase = np.where(i >= 0, np.where(p < 1.0, p, np.mod(p, 1.0)), phase)
-        return index, phase
+        return index, phase, spb
 
     def _nod_many(self, t: np.ndarray) -> np.ndarray:
         """:meth:`_nod` over an array of times: (m, 2, 4)."""

@@ -92,15 +92,11 @@ class BodySettings:
 
     @classmethod
     def load(cls, path: Path | None = None) -> BodySettings:
-        if path is None:
-            from virja.resources import motions_dir
-
-            path = motions_dir() / "drummer_body.toml"
-        if not path.is_file():
-            return cls()
         from virja.motion.settings_files import body_settings
+        from virja.resources import motions_file
 
-        return body_settings(path)
+        found = motions_file("drummer_body.toml", path)
+        return cls() if found is None else body_settings(found)
 
 
 class DrummerBody:

@@ -83,15 +83,11 @@ class HandSettings:
 
     @classmethod
     def load(cls, path: Path | None = None) -> HandSettings:
-        if path is None:
-            from virja.resources import motions_dir
-
-            path = motions_dir() / "drummer_hands.toml"
-        if not path.is_file():
-            return cls()
         from virja.motion.settings_files import hand_settings
+        from virja.resources import motions_file
 
-        return hand_settings(path)
+        found = motions_file("drummer_hands.toml", path)
+        return cls() if found is None else hand_settings(found)
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ every chain: :mod:`virja.plan.chain`.
 from __future__ import annotations
 
 from abc import abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from virja.events import NoteOn
@@ -50,18 +51,9 @@ class DrumChain(Chain[DrumHeld]):
     def emit_bounce(self, rec: Held, piece: str, limb: str) -> None:
         """A note played by the rebound of a stroke of ``limb`` on ``piece`` within the
         grouping window: its own impact time, no cost of its own."""
-        stroke = DrumStroke(as_piece(piece), as_limb(limb))
-        self.emit(
-            rec,
-            limb=stroke.limb,
-            piece=stroke.piece,
-            string=None,
-            fret=None,
-            motion=stroke,
-            cost=0.0,
-        )
+        self.emit_stroke([rec], piece, limb, 0.0)
 
-    def emit_stroke(self, recs: list[DrumHeld], piece: str, limb: str, cost: float) -> None:
+    def emit_stroke(self, recs: Sequence[Held], piece: str, limb: str, cost: float) -> None:
         """One stroke for ``recs`` (the same piece at once): shared motion, start and impact."""
         first = recs[0]
         stroke = DrumStroke(as_piece(piece), as_limb(limb))

@@ -271,11 +271,7 @@ class _Whole:
     def __init__(
         self, perf: Performance, feeder: RevealFeeder, times: list[float], chunk: int
     ) -> None:
-        # as session.run_schedule: at each reveal, what has started is committed, then fed
-        for r in feeder.schedule[feeder.next :]:
-            perf.advance(r.at_s)
-            feeder.until(perf, r.at_s)
-        perf.finish()
+        feeder.finish(perf)
         self.times = times
         self.chunk = max(chunk, 1)
         self.next = 0

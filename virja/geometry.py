@@ -229,6 +229,16 @@ def _make_kit(o: Vec) -> DrumKit:
         # both tipped toward the drummer
         "ride": Cymbal("ride", o + _v(-0.60, 1.02, 0.72), tilt(12, 0.1), 0.254),
         "crash": Cymbal("crash", o + _v(0.40, 1.20, 0.80), tilt(15, -0.1), 0.203),
+        # 18" crash 2 on the right (the TD-11's second crash, GM 57): on a boom over
+        # the low tom, between the rack toms and the ride, 22 cm higher than the ride
+        # and 27 cm in from its centre, so the two overlap seen from above (as on a
+        # real kit) with a hand's height between them; crash 1 mirrored, a little
+        # further out.  Tipped 18 deg toward the drummer and a little toward the
+        # middle.  Its lower edge hangs 22 cm over the low tom and, seen from above, 6 cm
+        # clear of the ride's strike point: the right stick plays the ride beside it.
+        # Nearer or higher and the left hand could not reach it across the body
+        # (tools/author_motions.py), nor could the right stick ride under it.
+        "crash2": Cymbal("crash2", o + _v(-0.36, 1.24, 0.86), tilt(18, 0.12), 0.229),
     }
     # pedals a shin's length ahead of the knees' plumb line, so the shins slope forward
     kick_pedal = Pedal(
@@ -246,6 +256,7 @@ def _make_kit(o: Vec) -> DrumKit:
         "hihat": 0.55,  # hi-hat and ride played between bell and edge
         "ride": 0.55,
         "crash": 0.85,  # crash struck near the edge
+        "crash2": 0.85,
     }
     return DrumKit(
         MappingProxyType(pieces),

@@ -40,9 +40,13 @@ PERFORMER_LIMBS: MappingProxyType[Performer, tuple[Limb, ...]] = MappingProxyTyp
 
 # -- the drum kit ----------------------------------------------------------------------
 
-Piece = Literal["kick", "snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash"]
+Piece = Literal[
+    "kick", "snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash", "crash2"
+]
 DRUM_PIECES: tuple[Piece, ...] = ("kick", "snare", "tom_high", "tom_low", "tom_floor")
-CYMBAL_PIECES: tuple[Piece, ...] = ("hihat", "ride", "crash")
+# crash: crash 1, front left over the hi-hat; crash2: crash 2 on the right, between the
+# rack toms and the ride and higher than the ride (the TD-11's second crash, GM 57)
+CYMBAL_PIECES: tuple[Piece, ...] = ("hihat", "ride", "crash", "crash2")
 PIECES: tuple[Piece, ...] = DRUM_PIECES + CYMBAL_PIECES
 # the pieces the hands play (either hand: the planner's cost table chooses)
 HAND_PIECES: tuple[Piece, ...] = (
@@ -53,6 +57,7 @@ HAND_PIECES: tuple[Piece, ...] = (
     "tom_floor",
     "ride",
     "crash",
+    "crash2",
 )
 # the pieces a foot plays, and the timing kind (motions/timing.toml) of each pedal stroke
 FOOT_KINDS: MappingProxyType[tuple[Piece, Foot], str] = MappingProxyType(

@@ -9,6 +9,7 @@ import random
 from virja.plan import drums
 from virja.plan.config import PlanConfig
 from virja.plan.drums import LEFT, RIGHT, HandGroup, Stroke
+from virja.vocab import HAND_PIECES
 
 SD = Stroke("snare", 0)
 RD = Stroke("ride", 1)
@@ -23,12 +24,13 @@ def test_table_reproduces_the_papers_snare_excerpt(config: PlanConfig) -> None:
     assert c.table[sl][sl] == 2
     assert c.table[c.none_row][sr] == 9
     assert c.table[c.none_row][sl] == 0
-    assert len(c.table) == 15 and all(len(r) == 14 for r in c.table)
+    # the paper's 15 x 14 and crash 2's two motions (rows and columns)
+    assert len(c.table) == 17 and all(len(r) == 16 for r in c.table)
 
 
 def test_none_row_gives_each_piece_a_zero_cost_hand(config: PlanConfig) -> None:
     c = config.costs
-    for piece in ("snare", "hihat", "tom_high", "tom_low", "tom_floor", "ride", "crash"):
+    for piece in HAND_PIECES:
         row = c.table[c.none_row]
         assert min(row[c.index(piece, RIGHT)], row[c.index(piece, LEFT)]) == 0
 
@@ -184,7 +186,7 @@ def test_dp_is_optimal_against_brute_force_on_random_sequences(config: PlanConfi
 
 
 def test_gm_map_covers_every_percussion_note_35_to_81(config: PlanConfig) -> None:
-    pieces = {"kick", "snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash"}
+    pieces = {*HAND_PIECES, "kick"}
     for note in range(35, 82):
         dn = config.kit.lookup(note)
         assert dn is not None, note
@@ -207,7 +209,7 @@ def test_the_groove_midi_datasets_td_pitches_are_kit_pieces(config: PlanConfig) 
         47: ("tom_low", "rim"),
         58: ("tom_floor", "rim"),
         55: ("crash", "edge"),
-        52: ("crash", "edge"),
+        52: ("crash2", "edge"),  # the TD-11's second crash, on the right
         53: ("ride", "bell"),
         59: ("ride", "edge"),
     }
@@ -220,7 +222,9 @@ def test_feet_and_folded_notes_follow_the_issue(config: PlanConfig) -> None:
     assert kit.notes[35].limb == kit.notes[36].limb == "right_foot"
     assert kit.notes[44].limb == "left_foot" and kit.notes[44].piece == "hihat"
     assert kit.notes[37].piece == "snare" and kit.notes[37].articulation == "side_stick"
-    assert kit.notes[55].piece == kit.notes[52].piece == "crash"
+    assert kit.notes[55].piece == kit.notes[49].piece == "crash"  # crash 1, front left
+    assert kit.notes[52].piece == kit.notes[57].piece == "crash2"  # crash 2, on the right
+    assert kit.notes[57].priority == kit.notes[49].priority
     assert kit.notes[53].piece == "ride"
     assert kit.notes[38].priority < kit.notes[42].priority == kit.notes[51].priority
     assert kit.notes[51].priority < kit.notes[45].priority < kit.notes[49].priority

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from virja.plan import bass, drums
 from virja.plan.config import DrumCosts, MotionTiming, PlanConfig, Timing
 from virja.plan.drums import RIGHT, Assignment, HandGroup, HandSolution, HandState, Stroke
+from virja.vocab import HAND_PIECES
 
 
 def _reference_drums(
@@ -116,7 +117,7 @@ def _reference_drums(
     )
 
 
-PIECES = ["snare", "hihat", "tom_high", "tom_low", "tom_floor", "ride", "crash"]
+PIECES = list(HAND_PIECES)
 ODD_COSTS = [-2.5, -1.0, 0.0, 0.1, 0.2, 0.5, 1.0, 1.25, 3.0, 9.0]
 
 
@@ -127,8 +128,8 @@ def _random_case(
     if rng.random() < 0.4:  # fractions and negatives: ties and rounding must match too
         table = tuple(
             tuple(rng.choice(ODD_COSTS) if rng.random() < 0.5 else float(rng.randint(0, 3))
-                  for _ in range(14))
-            for _ in range(15)
+                  for _ in range(len(costs.motions)))
+            for _ in range(len(costs.motions) + 1)
         )  # fmt: skip
         costs = DrumCosts(costs.motions, table, rng.choice([1000.0, 0.0, 2.5, -3.0, 0.1]))
     if rng.random() < 0.3:  # zero, tiny and long intervals, no rest or a short one

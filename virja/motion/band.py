@@ -116,6 +116,7 @@ class AnimationSettings:
         ("ride", 0.08, 1.0, 1.6),
         ("crash", 0.15, 1.5, 1.2),
         ("hihat", 0.03, 0.3, 3.0),
+        ("crash2", 0.13, 1.6, 1.0),
     )
     hihat_travel_m: float = 0.04
     hihat_lead_s: float = 0.06

@@ -47,7 +47,7 @@ class BandPose:
     - ``drums``, ``bass``: :class:`FigurePose` of the drummer and the bassist;
     - ``sticks``: (2, 2, 3) float64, [left, right] x [butt, tip] world points, metres;
     - ``hihat_open``: 0 (closed, pedal down) .. 1 (fully open), follows the left foot;
-    - ``cymbal_swing``: piece ("ride", "crash", "hihat") -> swing angle, radians
+    - ``cymbal_swing``: piece ("ride", "crash", "crash2", "hihat") -> swing angle, radians
       about a horizontal axis through the stand, damped after each stroke;
     - ``head_hits``: drum piece ("kick", "snare", "tom_high", "tom_low",
       "tom_floor") -> 0..1, jumps to the stroke's loudness at impact and decays;

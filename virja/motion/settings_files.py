@@ -50,6 +50,7 @@ class KitTable(Schema):
     crash_swing: Swing
     hihat_swing: Swing
     hihat_travel_m: float
+    crash2_swing: Swing | None = None  # absent (a file older than crash 2): crash 1's swing
     hihat_lead_s: float | None = None  # absent: AnimationSettings' default
     hihat_hold_open_s: float | None = None
 
@@ -88,7 +89,12 @@ def animation_settings(path: Path) -> AnimationSettings:
         sway_rad=f.idle.sway_rad,
         sway_period_s=f.idle.sway_period_s,
         head_decay_s=k.head_decay_s,
-        swing=(("ride", *k.ride_swing), ("crash", *k.crash_swing), ("hihat", *k.hihat_swing)),
+        swing=(
+            ("ride", *k.ride_swing),
+            ("crash", *k.crash_swing),
+            ("hihat", *k.hihat_swing),
+            ("crash2", *(k.crash_swing if k.crash2_swing is None else k.crash2_swing)),
+        ),
         hihat_travel_m=k.hihat_travel_m,
         hihat_lead_s=AnimationSettings.hihat_lead_s if k.hihat_lead_s is None else k.hihat_lead_s,
         hihat_hold_open_s=(

@@ -2,7 +2,8 @@
 
 - ``motions/bass.toml``: tunings, frets, double-stop span -> :class:`BassSetup`
 - ``motions/drum_kit.toml``: GM note -> piece, limb, priority -> :class:`DrumKit`
-- ``motions/drum_costs.toml``: the 15 x 14 hand table -> :class:`DrumCosts`
+- ``motions/drum_costs.toml``: the 17 x 16 hand table (the paper's 15 x 14 and crash 2's
+  rows and columns) -> :class:`DrumCosts`
 - ``motions/timing.toml``: anticipation and inter-stroke times -> :class:`Timing`
 
 A user config file (``virja plan --config FILE.toml``) may override under
@@ -142,7 +143,7 @@ class DrumKit:
 
 @dataclass(frozen=True)
 class DrumCosts:
-    """``table[row][col]``: rows are the 14 motions then "none" (index 14)."""
+    """``table[row][col]``: rows are the 16 motions then "none" (index 16)."""
 
     motions: tuple[str, ...]
     table: tuple[tuple[float, ...], ...]
@@ -389,15 +390,19 @@ def parse_costs(data: dict[str, Any], *, where: str = "drum_costs.toml") -> Drum
     f = convert(data, CostsFile, where)
     motions = tuple(f.motions)
     expected = {DrumStroke(p, h).name for p in HAND_PIECES for h in HANDS}
-    if set(motions) != expected or len(motions) != 14:
-        raise ConfigError(f"{where}: motions must be the 14 <piece>_<hand> motions")
+    if set(motions) != expected or len(motions) != len(expected):
+        missing = ", ".join(sorted(expected - set(motions)))
+        raise ConfigError(
+            f"{where}: motions must be the {len(expected)} <piece>_<hand> motions"
+            + (f" (missing {missing})" if missing else "")
+        )
     table = []
     for row_name in (*motions, "none"):
         if row_name not in f.rows:
             raise ConfigError(f"{where}: rows.{row_name} is missing")
         row = f.rows[row_name]
         if set(row) != set(motions):
-            raise ConfigError(f"{where}: row {row_name!r} must give all 14 columns")
+            raise ConfigError(f"{where}: row {row_name!r} must give all {len(motions)} columns")
         table.append(tuple(row[c] for c in motions))
     return DrumCosts(motions, tuple(table), f.drop_penalty)
 

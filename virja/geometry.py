@@ -62,6 +62,17 @@ class Cymbal:
     normal: Vec
     radius: float
     thickness: float = 0.004
+    # a boom stand: the top of its mast (3,), which stands on the floor below it, the
+    # boom reaching from there to under the cymbal; None: a straight stand under it
+    boom: Vec | None = None
+
+    def stand(self) -> tuple[Vec, ...]:
+        """The stand as a path from the floor to under the cymbal: two points (a
+        straight stand), or three (mast and boom)."""
+        top = self.centre - 0.02 * self.normal
+        if self.boom is None:
+            return (_v(self.centre[0], 0.0, self.centre[2]), top)
+        return (_v(self.boom[0], 0.0, self.boom[2]), np.asarray(self.boom, dtype=np.float64), top)
 
 
 @dataclass(frozen=True)
@@ -238,7 +249,15 @@ def _make_kit(o: Vec) -> DrumKit:
         # clear of the ride's strike point: the right stick plays the ride beside it.
         # Nearer or higher and the left hand could not reach it across the body
         # (tools/author_motions.py), nor could the right stick ride under it.
-        "crash2": Cymbal("crash2", o + _v(-0.36, 1.24, 0.86), tilt(18, 0.12), 0.229),
+        # A straight stand under it would stand in the bass drum and the low tom: it
+        # hangs on a boom whose mast stands behind the bass drum, right of its shell.
+        "crash2": Cymbal(
+            "crash2",
+            o + _v(-0.36, 1.24, 0.86),
+            tilt(18, 0.12),
+            0.229,
+            boom=o + _v(-0.44, 1.00, 1.26),
+        ),
     }
     # pedals a shin's length ahead of the knees' plumb line, so the shins slope forward
     kick_pedal = Pedal(

@@ -90,7 +90,15 @@ def test_glb_node_hierarchy_reproduces_the_band_pose(demo_export: Export, tmp_pa
     for fig in ("drums", "bass"):
         for joint in SKELETON.names:
             assert f"{fig}_{joint}" in names
-    for piece in ("kit_ride", "kit_crash", "kit_hihat", "kit_pedal_kick", "kit_pedal_hihat"):
+    for piece in (
+        "kit_ride",
+        "kit_crash",
+        "kit_crash2",
+        "kit_crash2_boom",  # crash 2 hangs on a boom
+        "kit_hihat",
+        "kit_pedal_kick",
+        "kit_pedal_hihat",
+    ):
         assert piece in names
     assert "drums_stick_left" in names and "bass_string_G" in names
     parents = {c: i for i, n in enumerate(doc.nodes) for c in (n.children or [])}

@@ -16,9 +16,8 @@ from virja.motion.drummer_body import BodySettings
 from virja.motion.drummer_hands import HandSettings
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import LIMB_JOINTS, SKELETON
-from virja.vocab import BASS_STRINGS, BassPluck, DrumStroke
+from virja.vocab import BASS_STRINGS, HAND_PIECES, BassPluck, DrumStroke
 
-HAND_PIECES = ("snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride", "crash")
 DRUM_MOTIONS = [f"{p}_{h}" for p in HAND_PIECES for h in ("left_hand", "right_hand")] + [
     "kick_right_foot",
     "hihat_left_foot",
@@ -230,11 +229,21 @@ def test_kit_state_follows_the_strokes(library: MotionLibrary) -> None:
     assert a.pose(1.6).head_hits["snare"] < 0.2
     assert a.pose(1.3).cymbal_swing["crash"] == 0.0
     assert abs(a.pose(1.5).cymbal_swing["crash"]) > 0.01
+    assert a.pose(1.5).cymbal_swing["crash2"] == 0.0  # crash 2 hangs still: not struck
     assert a.pose(1.2).hihat_open < 0.05  # pedal pressed: closed
     assert a.pose(0.5).hihat_open > 0.5  # foot resting: open
     assert a.pose(1.1).string_vibration["E"] == 0.0
     assert a.pose(1.3).string_vibration["E"] > 0.0
     assert a.pose(1.3).string_stops["E"] == 3
+
+
+def test_crash2_swings_on_its_own(library: MotionLibrary) -> None:
+    """Crash 2 (on the right) swings when struck and crash 1 stays still."""
+    a = BandAnimator(library, body=STILL, hands=CLIPS)
+    a.add_planned(drum("crash2_right_hand", 1.0, 1.4, velocity=110))
+    assert a.pose(1.3).cymbal_swing["crash2"] == 0.0
+    assert abs(a.pose(1.5).cymbal_swing["crash2"]) > 0.01
+    assert a.pose(1.5).cymbal_swing["crash"] == 0.0
 
 
 def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:

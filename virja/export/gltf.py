@@ -14,7 +14,8 @@ Layout of the file (names are stable; tools may look them up):
 - the sticks ``drums_stick_left`` / ``drums_stick_right`` are children of the
   drummer's hands;
 - the kit: ``kit_<piece>`` for every drum and cymbal; cymbals swing
-  (``kit_ride``, ``kit_crash``, ``kit_hihat`` rotate), the hi-hat's top cymbal
+  (``kit_ride``, ``kit_crash``, ``kit_crash2``, ``kit_hihat`` rotate; crash 2 hangs
+  on a boom, ``kit_crash2_boom``), the hi-hat's top cymbal
   rises as the left foot lets the pedal up, the pedal boards ``kit_pedal_kick``
   and ``kit_pedal_hihat`` follow the feet;
 - the bass: ``bass_instrument`` (rotated and moved as it leans with its player,
@@ -595,8 +596,9 @@ def _kit(b: GltfBuilder, stage: int, geo: Geometry, s: Sampled, anim: _Anim) -> 
                 b.segment(f"kit_{name}_stand", node, foot, back, 0.012, "chrome")
             continue
         assert isinstance(piece, Cymbal)
-        foot = np.array([piece.centre[0], 0.0, piece.centre[2]])
-        b.segment(f"kit_{name}_stand", k, foot, piece.centre - piece.normal * 0.02, 0.011, "chrome")
+        path = piece.stand()  # floor to under the cymbal: a stand, or mast and boom
+        for i, part in enumerate(("stand", "boom")[: len(path) - 1]):
+            b.segment(f"kit_{name}_{part}", k, path[i], path[i + 1], 0.011, "chrome")
         centre = piece.centre
         if name == "hihat":
             bottom = centre - np.array([0.0, 0.02, 0.0])

@@ -105,9 +105,9 @@ def static_scene(geo: Geometry = GEOMETRY) -> DrawList:
                 dl.add("cylinder", segment_transforms([foot], [back], 0.012), CHROME)
         else:
             assert isinstance(piece, Cymbal)
-            foot = np.array([piece.centre[0], 0.0, piece.centre[2]])
-            top = piece.centre - piece.normal * 0.02
-            dl.add("cylinder", segment_transforms([foot], [top], 0.011), CHROME)
+            path = piece.stand()  # floor to under the cymbal: a stand, or mast and boom
+            foot = path[0]
+            dl.add("cylinder", segment_transforms(path[:-1], path[1:], 0.011), CHROME)
             for k in (0, 1, 2):  # tripod legs
                 a = 2 * np.pi * k / 3
                 dl.add(

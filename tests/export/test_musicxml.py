@@ -9,7 +9,8 @@ import pytest
 
 from tests.export.conftest import GMD_TAKES, gmd_take
 from virja.export import Export, export_performance
-from virja.export.musicxml import NOTATION
+from virja.export.musicxml import NOTATION, notation
+from virja.vocab import PIECES
 
 
 @pytest.fixture(scope="module")
@@ -56,6 +57,14 @@ def test_drum_part_has_kit_noteheads_and_the_schedulers_sticking(
     }
     assert "x" in heads and "normal" in heads  # cymbals crossed, drums round
     assert {k for k in NOTATION if k[0] == "ride"}
+
+
+def test_every_kit_piece_has_its_own_staff_place() -> None:
+    """Each piece is written where drum charts put it, crash 2 apart from crash 1."""
+    assert all((p, None) in NOTATION for p in PIECES)
+    places = {p: notation(p, None)[:2] for p in PIECES if p != "hihat"}
+    assert len(set(places.values())) == len(places), places
+    assert notation("crash2", None) == ("B", 5, "x")
 
 
 def test_tempo_and_time_signature_come_from_the_file(demo_score: music21.stream.Score) -> None:

@@ -53,7 +53,8 @@ ALTERS = (0, -1, 0, -1, 0, 0, -1, 0, -1, 0, -1, 0)  # flats, as jazz charts spel
 
 # (piece, articulation) -> (display step, display octave, notehead); the usual
 # drum-set staff (PAS / Weinberg): kick F4, snare C5, toms E5 D5 A4, hi-hat G5 (x),
-# hi-hat pedal D4 (x), ride F5 (x), crash A5 (x)
+# hi-hat pedal D4 (x), ride F5 (x), crash A5 (x), crash 2 B5 (x: the space above
+# crash 1's ledger line, where drum charts put a second crash)
 NOTATION: dict[tuple[str, str | None], tuple[str, int, str]] = {
     ("kick", None): ("F", 4, "normal"),
     ("snare", None): ("C", 5, "normal"),
@@ -68,6 +69,7 @@ NOTATION: dict[tuple[str, str | None], tuple[str, int, str]] = {
     ("ride", None): ("F", 5, "x"),
     ("ride", "bell"): ("F", 5, "diamond"),
     ("crash", None): ("A", 5, "x"),
+    ("crash2", None): ("B", 5, "x"),
 }
 STICKING = {"right_hand": "R", "left_hand": "L"}
 

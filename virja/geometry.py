@@ -241,22 +241,23 @@ def _make_kit(o: Vec) -> DrumKit:
         "ride": Cymbal("ride", o + _v(-0.60, 1.02, 0.72), tilt(12, 0.1), 0.254),
         "crash": Cymbal("crash", o + _v(0.40, 1.20, 0.80), tilt(15, -0.1), 0.203),
         # 18" crash 2 on the right (the TD-11's second crash, GM 57): on a boom over
-        # the low tom, between the rack toms and the ride, 22 cm higher than the ride
-        # and 27 cm in from its centre, so the two overlap seen from above (as on a
-        # real kit) with a hand's height between them; crash 1 mirrored, a little
-        # further out.  Tipped 18 deg toward the drummer and a little toward the
-        # middle.  Its lower edge hangs 22 cm over the low tom and, seen from above, 6 cm
-        # clear of the ride's strike point: the right stick plays the ride beside it.
-        # Nearer or higher and the left hand could not reach it across the body
-        # (tools/author_motions.py), nor could the right stick ride under it.
-        # A straight stand under it would stand in the bass drum and the low tom: it
-        # hangs on a boom whose mast stands behind the bass drum, right of its shell.
+        # the low tom's far side, between the rack toms and the ride, 16 cm higher
+        # than the ride and 28 cm in from its centre, so the two overlap seen from
+        # above (as on a real kit) with a stick's room between them (11 cm); crash 1
+        # mirrored, a little further out.  Tipped 18 deg toward the drummer and a
+        # little toward the middle.  Seen from above its rim stays 3 cm off the low
+        # tom's strike point and 10 cm off the ride's: a stick going down to either
+        # never passes under it.  Nearer, and the stick from crash 2 to the low tom
+        # went under its rim; further or higher, and the left hand could not reach
+        # it across the body (tools/author_motions.py).  A straight stand under it
+        # would stand in the bass drum and the low tom: it hangs on a boom whose
+        # mast stands behind the bass drum, right of its shell.
         "crash2": Cymbal(
             "crash2",
-            o + _v(-0.36, 1.24, 0.86),
+            o + _v(-0.40, 1.18, 0.92),
             tilt(18, 0.12),
             0.229,
-            boom=o + _v(-0.44, 1.00, 1.26),
+            boom=o + _v(-0.44, 0.98, 1.28),
         ),
     }
     # pedals a shin's length ahead of the knees' plumb line, so the shins slope forward

@@ -135,5 +135,26 @@ def test_groove_midi_dataset_takes_drop_no_kit_note(path: Path) -> None:
     assert {p.note for p in planned} & {22, 26, 40, 47, 50, 52, 53, 55, 58, 59}
 
 
+def test_crash_2_notes_are_played_on_crash_2_by_the_right_hand() -> None:
+    """GMD drummer7 session2 take 54: 52 (the TD-11's crash 2 edge) at 52.269 s, a
+    snare accent 15 ms later, a soft ride note 47 ms later.  On one crash, front left,
+    the ride note was dropped; with crash 2 beside the ride the right hand plays the
+    crash and goes on to the ride while the left takes the snare."""
+    path = GMD / "drummer7_session2_54_soul-motown_148_beat_4-4.mid"
+    session = read_midi(path)
+    router = Router.for_session(session)
+    notes = [(w, e) for w, e in route_all(session.events, router) if isinstance(e, NoteOn)]
+    planned, report = plan_notes_with_report(notes, session.tempo_map)
+    assert report.dropped == ()
+    crash2 = [p for p in planned if p.note in (52, 57)]
+    assert crash2 and all(p.piece == "crash2" for p in crash2)
+    moment = sorted((p for p in planned if 52.26 < p.time < 52.32), key=lambda p: p.time)
+    assert [(p.note, p.limb) for p in moment if p.limb.endswith("hand")] == [
+        (52, "right_hand"),
+        (38, "left_hand"),
+        (51, "right_hand"),
+    ]
+
+
 def test_the_sample_is_there() -> None:
     assert len(GMD_FILES) >= 3

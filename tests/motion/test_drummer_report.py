@@ -61,6 +61,33 @@ def test_hihat_agreement_and_speeds_on_a_groove(library: MotionLibrary) -> None:
     assert json.loads(json.dumps(out)) == out
 
 
+def test_crash2_accents_over_a_ride_pattern_touch_nothing(library: MotionLibrary) -> None:
+    """Crash 2 hangs over the low tom beside the ride: the right hand going ride ->
+    crash 2 -> low tom -> ride strikes each and passes under none of them."""
+    notes = []
+    for i in range(16):
+        t = 1.0 + 0.25 * i
+        if i % 8 == 0:
+            notes += [("drums", NoteOn(t, 9, 57, 110)), ("drums", NoteOn(t, 9, 36, 100))]
+        elif i % 8 == 1:
+            notes.append(("drums", NoteOn(t, 9, 45, 90)))  # low tom, under crash 2's side
+        else:
+            notes.append(("drums", NoteOn(t, 9, 51, 80)))
+    planned = plan_notes(notes, ConstantTempo(0.5))  # type: ignore[arg-type]
+    crash2 = [p for p in planned if p.note == 57]
+    assert len(crash2) == 2 and {(p.piece, p.limb) for p in crash2} == {("crash2", "right_hand")}
+    a = BandAnimator(library)
+    for p in planned:
+        a.add_planned(p)
+    kit = default_config().kit
+    fig = measure_drummer(a, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=120)
+    assert {k: fig.collisions[k] for k in ("stick-crash2", "stick-ride", "stick-tom_low")} == {
+        "stick-crash2": 0,
+        "stick-ride": 0,
+        "stick-tom_low": 0,
+    }
+
+
 def test_motion_report_json_gives_every_figure(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

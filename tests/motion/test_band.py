@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -244,6 +245,21 @@ def test_crash2_swings_on_its_own(library: MotionLibrary) -> None:
     assert a.pose(1.3).cymbal_swing["crash2"] == 0.0
     assert abs(a.pose(1.5).cymbal_swing["crash2"]) > 0.01
     assert a.pose(1.5).cymbal_swing["crash"] == 0.0
+
+
+def test_an_animation_file_without_crash2_swings_crash2_like_crash1(tmp_path: Path) -> None:
+    """animation.toml written before crash 2: it swings as crash 1 does."""
+    from virja.motion.band import AnimationSettings
+    from virja.resources import motions_dir
+
+    text = (motions_dir() / "animation.toml").read_text()
+    old = "\n".join(ln for ln in text.splitlines() if not ln.startswith("crash2_swing"))
+    assert old != text
+    (tmp_path / "animation.toml").write_text(old)
+    swing = {s[0]: s[1:] for s in AnimationSettings.load(tmp_path / "animation.toml").swing}
+    assert swing["crash2"] == swing["crash"]
+    shipped = {s[0]: s[1:] for s in AnimationSettings.load().swing}
+    assert shipped["crash2"] != shipped["crash"]  # its own: 18", heavier
 
 
 def test_pose_fields_have_documented_shapes(library: MotionLibrary) -> None:

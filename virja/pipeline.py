@@ -111,6 +111,7 @@ def perform(
     *,
     animate: bool = False,
     until_s: float | None = None,
+    as_live_fps: float | None = None,
 ) -> tuple[Performance, list[PlannedNote]]:
     """A whole input through :func:`build_performance` on a virtual clock, as fast as
     possible (:func:`virja.session.run_schedule`): each event fed when it becomes known,
@@ -118,9 +119,11 @@ def perform(
     start) leaves out the notes that sound after it (their note-offs and the beats stay).
     Returns the performance (its planner's report, its animator) and every planned note
     in commit order; ``plan``, ``motion-report`` and the capture tools plan here, so their
-    plans are the ones render draws."""
+    plans are the ones render draws.  ``as_live_fps``: instead, frames of ``1/fps`` drawn
+    as the live window draws them (:func:`virja.session.run_as_live`; the same plan),
+    so the animator ends with the motion the window showed."""
     from virja.events import NoteOn
-    from virja.session import run_schedule
+    from virja.session import run_as_live, run_schedule
 
     schedule = src.schedule
     if until_s is not None:
@@ -130,4 +133,6 @@ def perform(
         ]
     perf = build_performance(settings, src, animate=animate)
     perf.keep_planned = False
+    if as_live_fps is not None:
+        return perf, run_as_live(perf, schedule, as_live_fps, src.start_s)
     return perf, run_schedule(perf, schedule)

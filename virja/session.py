@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -49,6 +50,11 @@ class PlanSink(Protocol):
     def add_beat(self, beat: Beat) -> None: ...
 
 
+# A sink may also take ``note_provisional(notes)``: the drummer's hand notes not yet
+# started with the hand the plan gives them now, the whole current set each time
+# (``OnlinePlanner.provisional``); a note left out of it, or fixed, is no longer so.
+
+
 class Performance:
     """Routes events, plans motions, animates the band; counts what it did."""
 
@@ -76,6 +82,11 @@ class Performance:
         self.taps: list[Callable[[Event], None]] = []  # see every event fed (the web viewer)
         self.planned_taps: list[Callable[[PlannedNote], None]] = []  # and every note committed
         self.plan_log_failed: str | None = None
+        # the hands the plan gives the drummer's notes not yet started, told to a sink
+        # that takes them (note_provisional) whenever they change; off where nothing is
+        # drawn before the end (run_schedule: the whole input known)
+        self.tell_provisional = True
+        self._provisional: list[PlannedNote] = []
 
     @property
     def animator(self) -> PlanSink | None:
@@ -136,6 +147,8 @@ class Performance:
                 known(performer, event, now_s)
             self.planner.add_note(performer, event, now_s=now_s)
             self.counts[f"notes_{performer}"] += 1
+            if performer == "drums":
+                self._tell_provisional()
         elif isinstance(event, NoteOff):
             if self.animator is not None:
                 note_off = getattr(self.animator, "note_off", None)
@@ -153,7 +166,24 @@ class Performance:
 
     def advance(self, now_s: float) -> list[PlannedNote]:
         """Commit the motions that have started by ``now_s``; log and animate them."""
-        return self._commit(self.planner.poll(now_s))
+        notes = self._commit(self.planner.poll(now_s))
+        if any(p.performer == "drums" for p in notes):
+            self._tell_provisional()
+        return notes
+
+    def _tell_provisional(self) -> None:
+        """The plan's current hands for the drum notes not yet started, to a sink that
+        takes them (``note_provisional``), when they changed since last told."""
+        if not self.tell_provisional:
+            return
+        tell = getattr(self.animator, "note_provisional", None)
+        look = getattr(self.planner, "provisional", None)
+        if tell is None or look is None:
+            return
+        notes: list[PlannedNote] = look()
+        if notes != self._provisional:
+            self._provisional = notes
+            tell(notes)
 
     def finish(self) -> list[PlannedNote]:
         """Commit everything still pending (end of a file or a replay)."""
@@ -269,8 +299,36 @@ def run_schedule(perf: Performance, schedule: list[Reveal]) -> list[PlannedNote]
     arrives.  Returns every planned note, in commit order.
     """
     out: list[PlannedNote] = []
-    for r in schedule:
-        out.extend(perf.advance(r.at_s))
-        perf.feed(r.event, now_s=r.at_s)
-    out.extend(perf.finish())
+    told, perf.tell_provisional = perf.tell_provisional, False  # nothing drawn meanwhile
+    try:
+        for r in schedule:
+            out.extend(perf.advance(r.at_s))
+            perf.feed(r.event, now_s=r.at_s)
+        out.extend(perf.finish())
+    finally:
+        perf.tell_provisional = told
+    return out
+
+
+def run_as_live(
+    perf: Performance, schedule: list[Reveal], fps: float, t0_s: float
+) -> list[PlannedNote]:
+    """Play a reveal schedule as the live window draws it: frames of exactly ``1/fps``
+    from ``t0_s`` (:func:`frame_times`), at each what became known is fed, what
+    started committed, and the frame marked drawn (``mark_drawn``): a later plan
+    changes nothing up to there, so the animator ends with the motion the window
+    showed.  Runs until every event is fed and every note has sounded; returns
+    every planned note, in commit order (the plan equals :func:`run_schedule`'s)."""
+    feeder = RevealFeeder(schedule)
+    end_s = max((r.event.time_s for r in schedule), default=t0_s)
+    start_s = min([t0_s, *(r.at_s for r in schedule[:1])])
+    start_s = t0_s - math.ceil((t0_s - start_s) * fps - 1e-9) / fps  # on the frame grid
+    out: list[PlannedNote] = []
+    for t in frame_times(start_s, end_s, fps):
+        feeder.until(perf, t)
+        out.extend(perf.advance(t))
+        mark = getattr(perf.animator, "mark_drawn", None)
+        if mark is not None:
+            mark(t)
+    out.extend(feeder.finish(perf))
     return out

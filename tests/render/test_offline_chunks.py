@@ -48,7 +48,9 @@ def test_chunked_frames_equal_the_plain_loop(path: Path) -> None:
         p.to_log_json(0.0) for p in plain.planned
     ]
     assert ahead.chunks.frames == len(times)  # each frame posed once
-    assert ahead.chunks.chunks < len(times) / 2  # in stretches of frames, not one by one
+    # in stretches of frames, not one by one (a dense take's news: every arrival of a
+    # hand note tells the provisional hands, every start the fixed plan)
+    assert ahead.chunks.chunks < len(times) * 0.6
     with pytest.raises(ValueError, match="in order"):
         ahead.scene(times[0])
 

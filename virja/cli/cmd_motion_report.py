@@ -57,6 +57,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--fps", type=finite_float, default=120.0, help="sampling rate for continuity (default 120)"
     )
+    parser.add_argument(
+        "--as-live",
+        action="store_true",
+        help="measure the motion the live window shows (frames at 30 fps, each knowing "
+        "only what was known by then: render --as-live), not the whole input known",
+    )
     parser.add_argument("--per-note", action="store_true", help="also print one line per note")
     parser.add_argument("--json", action="store_true", help="one JSON object with every figure")
     add_routing_arguments(parser)
@@ -82,7 +88,13 @@ def run(args: argparse.Namespace) -> int:
     # note-offs and beats, each revealed --lookahead-beats ahead
     settings = performance_settings(args, load_config(args.config))
     src = load_performance_input(path, settings.routing, lookahead_beats=args.lookahead_beats)
-    perf, planned = perform(settings, src, animate=True, until_s=args.max_seconds)
+    perf, planned = perform(
+        settings,
+        src,
+        animate=True,
+        until_s=args.max_seconds,
+        as_live_fps=AS_LIVE_FPS if args.as_live else None,
+    )
     report = perf.planner.report
     animator = perf.animator
     assert isinstance(animator, BandAnimator)
@@ -113,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
     progress.done()
     if args.json:
         doc = _json(path, planned, rep, drummer, drops, dict(report.unplayed), pose_ms)
+        if args.as_live:  # how the hands shown before their plan was fixed fared
+            doc["as_live"] = {"fps": AS_LIVE_FPS, **_provisional(animator)}
         if bassist is not None:
             doc["bass"] |= {
                 "figures": dataclasses.asdict(bassist),
@@ -146,10 +160,28 @@ def run(args: argparse.Namespace) -> int:
     print(f"pose time (both players): {pose_ms:.2f} ms per frame")
     for line in _drummer_table(rep, drummer, drops):
         print(line)
+    if args.as_live:
+        shown = _provisional(animator)
+        print(
+            f"as live ({AS_LIVE_FPS:g} fps): {shown['shown']} provisional hand strokes shown, "
+            f"fixed as shown {shown['fixed_same']}, fixed with the other hand "
+            f"{shown['fixed_other']}, revised before fixing {shown['revised']}, "
+            f"taken back {shown['taken_back']}"
+        )
     if bassist is not None:
         for line in bassist.lines():
             print(line)
     return 0
+
+
+AS_LIVE_FPS = 30.0  # --as-live: the frame rate of render --as-live and the window's timer
+
+
+def _provisional(animator: Any) -> dict[str, int]:
+    """The animator's counts of provisional hand strokes (BandAnimator.provisional_counts)."""
+    counts = animator.provisional_counts
+    keys = ("shown", "fixed_same", "fixed_other", "revised", "taken_back")
+    return {k: int(counts.get(k, 0)) for k in keys}
 
 
 CONTINUITY_RATIO = 1.5  # a connection may change velocity this much more than a clip does

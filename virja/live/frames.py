@@ -118,6 +118,10 @@ class FrameLoop:
                 known = getattr(self.animator, "note_known", None)
                 if known is not None:
                     known(item[1], item[2], item[3])
+            elif kind == "provisional":  # the plan's current hands for notes not started
+                provisional = getattr(self.animator, "note_provisional", None)
+                if provisional is not None:
+                    provisional(item[1])
             elif kind == "beat":
                 self.animator.add_beat(item[1])
                 self.hud.add(item[1])

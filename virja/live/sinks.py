@@ -59,6 +59,14 @@ class Fanout:
             if call is not None:
                 call(performer, note, at_s)
 
+    def note_provisional(self, notes: list[PlannedNote]) -> None:
+        """The plan's current hands for notes not yet started, to every sink that
+        animates a drummer's hands."""
+        for s in self.sinks:
+            call = getattr(s, "note_provisional", None)
+            if call is not None:
+                call(notes)
+
     def add_beat(self, beat: Beat) -> None:
         for s in self.sinks:
             s.add_beat(beat)

@@ -114,6 +114,11 @@ class Viewer:
         """When a note became known: the window's drummer may move toward it from then."""
         self._put(("known", performer, note, at_s))
 
+    def note_provisional(self, notes: list[PlannedNote]) -> None:
+        """The plan's current hands for notes not yet started: the window's drummer
+        moves toward them, and re-targets when the plan fixes another hand."""
+        self._put(("provisional", list(notes)))
+
     def add_beat(self, beat: Beat) -> None:
         self._put(("beat", beat))
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 import bisect
 import logging
 import math
-from collections.abc import Mapping
+from collections import Counter
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -175,6 +176,10 @@ class BandAnimator:
         # latest frame shown (mark_drawn): a note changes nothing at or before it
         self._known: dict[tuple[str, int, int, float], float] = {}
         self.drawn_until = -math.inf
+        # the drummer's hand strokes shown before their plan is fixed (note_provisional),
+        # by note: (hand, the provisional note); and how they fared (provisional_counts)
+        self._provisional: dict[tuple[str, int, int, float], tuple[str, PlannedNoteLike]] = {}
+        self.provisional_counts: Counter[str] = Counter()
 
     def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
         """The kit map's articulation per drum note number (``PlanConfig.kit.notes``):
@@ -227,6 +232,38 @@ class BandAnimator:
         key = (performer, int(note.channel), int(note.note), round(float(note.time_s), 9))
         self._known[key] = min(float(at_s), self._known.get(key, math.inf))
 
+    def note_provisional(self, notes: Iterable[PlannedNoteLike]) -> None:
+        """The plan's current hand for each drum note not yet started (the whole set:
+        ``OnlinePlanner.provisional``): a free hand moves toward its piece from when
+        the note became known, as when the plan is fixed.  A note whose hand or stroke
+        changed since last told, or that is no longer in the set, is taken back: the
+        frames drawn (:attr:`drawn_until`) stay, the hand goes on from where it is.
+        :meth:`add_planned` then keeps the stroke when the plan fixes the same hand,
+        and re-targets both hands from their poses after the last frame drawn when it
+        fixes the other."""
+        new = {_note_key(p): p for p in notes if p.performer == "drums"}
+        for key, (hand, old) in list(self._provisional.items()):
+            p = new.get(key)
+            if p is None or not _same_stroke(old, p):
+                self.hands.remove_stroke(hand, key, self.drawn_until)
+                del self._provisional[key]
+                self.provisional_counts["revised" if p is not None else "taken_back"] += 1
+        for key, p in new.items():
+            if key in self._provisional or not isinstance(p.motion, DrumStroke):
+                continue
+            clip = self.library[p.motion.clip]
+            hand = clip.limb or p.limb
+            if hand not in ("left_hand", "right_hand"):
+                continue
+            told = self._known.get(key, p.start)
+            course = max(min(told, p.start), self.drawn_until)
+            art = self.articulations.get(p.note)
+            self.hands.add_stroke(
+                hand, course, p.impact, clip, p.velocity, art, key=key, drawn=self.drawn_until
+            )
+            self._provisional[key] = (hand, p)
+            self.provisional_counts["shown"] += 1
+
     def add_planned(self, p: PlannedNoteLike, known_at: float | None = None) -> None:
         """Schedule the motions of one planned note (its start and impact are kept exactly).
 
@@ -237,7 +274,7 @@ class BandAnimator:
 
         Raises :class:`UnknownMotionError` when the library lacks the motion.
         """
-        key = (p.performer, int(getattr(p, "channel", 0)), p.note, round(p.time, 9))
+        key = _note_key(p)
         told = self._known.pop(key, None)
         if known_at is None:
             known_at = told
@@ -264,7 +301,17 @@ class BandAnimator:
             art = self.articulations.get(p.note)
             course = p.start if known_at is None else min(known_at, p.start)
             course = max(course, self.drawn_until)
-            self.hands.add_stroke(limb, course, p.impact, clip, p.velocity, art)
+            shown = self._provisional.pop(key, None)
+            if shown is not None and shown[0] == limb and _same_stroke(shown[1], p):
+                self.hands.keep_stroke(limb, key)  # the stroke shown is the one played
+                self.provisional_counts["fixed_same"] += 1
+            else:
+                if shown is not None:  # the plan fixed the other hand (or another stroke)
+                    self.hands.remove_stroke(shown[0], key, self.drawn_until)
+                    self.provisional_counts["fixed_other"] += 1
+                self.hands.add_stroke(
+                    limb, course, p.impact, clip, p.velocity, art, drawn=self.drawn_until
+                )
             self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
@@ -323,6 +370,7 @@ class BandAnimator:
         self.body.forget_before(time_s)
         self.hands.forget_before(time_s)
         self._known = {k: v for k, v in self._known.items() if k[3] >= time_s - 10.0}
+        self._provisional = {k: v for k, v in self._provisional.items() if k[3] >= time_s - 10.0}
         self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
@@ -600,6 +648,19 @@ class BandAnimator:
                     out[inst.clip.string] = inst.clip.fret
                 break
         return out
+
+
+def _note_key(p: Any) -> tuple[str, int, int, float]:
+    """A note's identity from its arrival to its plan: performer, channel, note, time."""
+    time = getattr(p, "time", None)
+    if time is None:
+        time = p.time_s
+    return (str(p.performer), int(getattr(p, "channel", 0)), int(p.note), round(float(time), 9))
+
+
+def _same_stroke(a: PlannedNoteLike, b: PlannedNoteLike) -> bool:
+    """Whether two plans of one note move its hand the same way."""
+    return (a.limb, a.motion, a.impact, a.velocity) == (b.limb, b.motion, b.impact, b.velocity)
 
 
 def sticks(wpos: np.ndarray, wrot: np.ndarray) -> np.ndarray:

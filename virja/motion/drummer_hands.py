@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import bisect
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -119,6 +120,42 @@ class _Keys:
     end_rows: np.ndarray  # (K, 10): grip, rot, elbow
     lift_end_t: np.ndarray  # (L,)
     lift_end: np.ndarray  # (L,)
+
+
+@dataclass
+class _Base:
+    """A hand's track frozen up to ``t`` (a frame drawn then): its keys up to there
+    (cut at ``t``, :func:`_cut`) and the last stroke landed by then (impact time,
+    lift, impact pose row) or None.  Strokes later than ``t`` are built on from it
+    (:meth:`DrummerHands._build`), so a change of plan never changes a frame drawn."""
+
+    t: float
+    pt: list[float]
+    pv: list[np.ndarray]
+    pp: list[Any]
+    lt: list[float]
+    lv: list[float]
+    lp: list[Any]
+    last: tuple[float, float, np.ndarray] | None
+
+
+def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
+    """Whether two key tracks give the same poses at every time up to ``t``: the same
+    keys up to ``t`` and the same segment across it."""
+    tracks = (
+        ("t", "grip", "rot", "elbow", "profile", "end_t", "end_rows"),
+        ("lift_t", "lift", "lift_profile", "lift_end_t", "lift_end"),
+    )
+    for names in tracks:
+        ta, tb = getattr(a, names[0]), getattr(b, names[0])
+        n = int(np.searchsorted(ta, t, side="right"))
+        if n != int(np.searchsorted(tb, t, side="right")):
+            return False
+        for name in names:
+            x, y = getattr(a, name)[: n + 1], getattr(b, name)[: n + 1]
+            if x.shape != y.shape or not np.array_equal(x, y):
+                return False
+    return True
 
 
 def _shaped(
@@ -249,13 +286,19 @@ class DrummerHands:
         )
         self._poses: dict[tuple[str, int], _Pose] = {}
         self._keys: dict[str, _Keys | None] = dict.fromkeys(HANDS)
+        # per stroke, beside _strokes: the key it was added under (remove_stroke) or None
+        self._ids: dict[str, list[object]] = {h: [] for h in HANDS}
+        # the track frozen up to a frame drawn (_Base), and the last build's key lists
+        # and strokes landed (what a freeze cuts)
+        self._base: dict[str, _Base | None] = dict.fromkeys(HANDS)
+        self._lists: dict[str, tuple[Any, ...] | None] = dict.fromkeys(HANDS)
 
     @property
     def enabled(self) -> bool:
         return self.settings.enabled
 
     def has_strokes(self, hand: str) -> bool:
-        return bool(self._times.get(hand))
+        return bool(self._times.get(hand)) or self._base.get(hand) is not None
 
     # ------------------------------------------------------------------ input
 
@@ -289,6 +332,9 @@ class DrummerHands:
         clip: Clip,
         velocity: int,
         articulation: str | None = None,
+        *,
+        key: object = None,
+        drawn: float = -math.inf,
     ) -> None:
         """Record a stroke of ``hand`` landing at ``impact`` as ``clip``'s impact frame.
 
@@ -296,17 +342,68 @@ class DrummerHands:
         became known and nothing later was drawn yet (:meth:`BandAnimator.add_planned`
         gives that), so what was drawn before stays true; the hand also waits for its
         previous impact.  ``articulation`` from the kit map: a side-stick lifts
-        little, a rim shot fully.
+        little, a rim shot fully.  ``key``: a stroke that may be taken back
+        (:meth:`remove_stroke`); ``drawn``: the last frame shown, which the new stroke
+        must not change (strokes are built on from there if it would, :meth:`_change`).
         """
         if hand not in self._times:
             return
         if self._rest[hand] is None:
             self._rest[hand] = self._clip_pose(clip, 0)
         pose = self._clip_pose(clip, int(round(clip.impact_s * clip.fps)))
-        i = bisect.bisect_right(self._times[hand], impact)
-        self._times[hand].insert(i, impact)
-        self._strokes[hand].insert(i, (min(start, impact), pose, int(velocity), articulation))
+
+        def insert() -> None:
+            i = bisect.bisect_right(self._times[hand], impact)
+            self._times[hand].insert(i, impact)
+            self._strokes[hand].insert(i, (min(start, impact), pose, int(velocity), articulation))
+            self._ids[hand].insert(i, key)
+
+        self._change(hand, drawn, insert)
+
+    def remove_stroke(self, hand: str, key: object, drawn: float = -math.inf) -> bool:
+        """Take back the stroke added under ``key`` (a provisional hand the plan revised):
+        the frames up to ``drawn`` stay as they were, from there the hand goes on from
+        where it is.  False when ``hand`` has no such stroke."""
+        ids = self._ids.get(hand)
+        if ids is None or key not in ids:
+            return False
+        i = ids.index(key)
+
+        def delete() -> None:
+            del self._times[hand][i], self._strokes[hand][i], self._ids[hand][i]
+
+        self._change(hand, drawn, delete)
+        return True
+
+    def keep_stroke(self, hand: str, key: object) -> None:
+        """The stroke added under ``key`` is no longer provisional: it stays as it is."""
+        ids = self._ids.get(hand)
+        if ids is not None and key in ids:
+            ids[ids.index(key)] = None
+
+    def _change(self, hand: str, drawn: float, apply: Callable[[], None]) -> None:
+        """``apply`` a change of ``hand``'s strokes without changing its track at or
+        before ``drawn``: if the rebuilt track differs there, the old one is frozen
+        up to ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
+        old = self.keys(hand) if drawn > -math.inf else None
+        old_lists = self._lists[hand]
+        apply()
         self._keys[hand] = None
+        if old is None or old_lists is None:
+            return
+        new = self.keys(hand)
+        if new is not None and _same_until(old, new, drawn):
+            return
+        self._freeze(hand, drawn, old_lists)
+        self._keys[hand] = None
+
+    def _freeze(self, hand: str, t: float, lists: tuple[Any, ...]) -> None:
+        """Freeze ``hand``'s track (the build that gave ``lists``) up to ``t``."""
+        pt, pv, pp, lt, lv, lp, landed = (list(x) for x in lists)
+        _cut(pt, pv, pp, t, _pose_at)
+        _cut(lt, lv, lp, t, _lift_at)
+        done = [x for x in landed if x[0] <= t]
+        self._base[hand] = _Base(t, pt, pv, pp, lt, lv, lp, done[-1] if done else None)
 
     def forget_before(self, time_s: float) -> None:
         horizon = time_s - 10.0
@@ -315,7 +412,16 @@ class DrummerHands:
             if k:
                 del self._times[h][:k]
                 del self._strokes[h][:k]
+                del self._ids[h][:k]
                 self._keys[h] = None
+            base = self._base[h]
+            if base is not None:  # keys long past: the last before the horizon is enough
+                k = max(bisect.bisect_right(base.pt, horizon) - 1, 0)
+                j = max(bisect.bisect_right(base.lt, horizon) - 1, 0)
+                if k or j:
+                    del base.pt[:k], base.pv[:k], base.pp[:k]
+                    del base.lt[:j], base.lv[:j], base.lp[:j]
+                    self._keys[h] = None
 
     # ------------------------------------------------------------------ keys
 
@@ -344,18 +450,32 @@ class DrummerHands:
         lp: list[Any] = []
         prev_t: float | None = None
         prev_lift = 0.0
+        landed: list[tuple[float, float, np.ndarray]] = []  # (impact, lift, pose row)
+        base = self._base[hand]
+        floor = -math.inf
+        if base is not None:  # frozen up to a frame drawn: build on from there
+            floor = base.t
+            pt, pv, pp = list(base.pt), list(base.pv), list(base.pp)
+            lt, lv, lp = list(base.lt), list(base.lv), list(base.lp)
+            if base.last is not None:
+                landed.append(base.last)
+                prev_t, prev_lift = base.last[0], base.last[1]
+            self._settle(hand, base, pt, pv, pp, lt, lv, lp)
         for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
-            if prev_t is not None and t - prev_t < 1e-6:
+            if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
             target = np.concatenate([pose.grip, pose.rot, pose.elbow])
-            if prev_t is None:
+            if base is not None:
+                start = max(start, floor)
+            if prev_t is None and base is None:
                 cut, gap = start, math.inf
                 here = np.concatenate([rest.grip, rest.rot, rest.elbow])
                 pt, pv, pp = [cut], [here], [_SMOOTH]
                 lt, lv, lp = [cut], [0.0], [_SMOOTH]
                 lift_here = 0.0
             else:
-                cut, gap = max(start, prev_t), t - prev_t
+                cut = start if prev_t is None else max(start, prev_t)
+                gap = math.inf if prev_t is None else t - prev_t
                 here = _cut(pt, pv, pp, cut, _pose_at)
                 lift_here = float(_cut(lt, lv, lp, cut, _lift_at))
             lift = self._lift_for(vel, gap, art)
@@ -364,7 +484,7 @@ class DrummerHands:
             down = min(down, 0.5 * room) if room > 0 else 0.0
             rise = min(2 * down + 0.05, 0.5 * gap)
             travel = float(np.linalg.norm(target[:3] - here[:3])) / s.move_speed_m_s
-            if prev_t is None:
+            if prev_t is None and base is None:
                 travel = max(travel, s.rest_move_s)
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:
@@ -398,6 +518,8 @@ class DrummerHands:
             home = np.concatenate([rest.grip, rest.rot, rest.elbow])
             _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
             prev_t, prev_lift = t, lift
+            landed.append((t, lift, target))
+        self._lists[hand] = (pt, pv, pp, lt, lv, lp, landed)
         rows = np.array(pv)
         seg = [_segment(*k) for k in zip(pp, pt, pv, strict=True)]
         lseg = [_segment(*k) for k in zip(lp, lt, lv, strict=True)]
@@ -416,8 +538,42 @@ class DrummerHands:
             np.array([g[2] for g in lseg], dtype=np.float64),
         )
 
+    def _settle(
+        self,
+        hand: str,
+        base: _Base,
+        pt: list[float],
+        pv: list[np.ndarray],
+        pp: list[Any],
+        lt: list[float],
+        lv: list[float],
+        lp: list[Any],
+    ) -> None:
+        """After a frozen track (a stroke taken back), the hand goes from where it is
+        back over the piece it last played, at a hover (or to the ready pose when it
+        played nothing yet), and rests after a while as after any stroke."""
+        s = self.settings
+        rest = self._rest[hand]
+        assert rest is not None
+        home = np.concatenate([rest.grip, rest.rot, rest.elbow])
+        here = pv[-1]
+        target = home if base.last is None else base.last[2]
+        travel = float(np.linalg.norm(target[:3] - here[:3])) / s.move_speed_m_s
+        back = base.t + max(travel, s.down_max_s)
+        _add(pt, pv, pp, back, target, _MOVE)
+        if base.last is None:
+            _add(lt, lv, lp, back, 0.0, _SMOOTH)
+            return
+        hover = min(s.hover_m, base.last[1])
+        _add(lt, lv, lp, back, hover, _SMOOTH)
+        away = max(base.last[0] + 0.5 * s.rest_after_s, back + 1e-3)
+        _add(lt, lv, lp, away, hover, _SMOOTH)
+        _add(lt, lv, lp, away + s.rest_move_s, 0.0, _SMOOTH)
+        _add(pt, pv, pp, away, target, _SMOOTH)
+        _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
+
     def keys(self, hand: str) -> _Keys | None:
-        if not self._times[hand]:
+        if not self._times[hand] and self._base[hand] is None:
             return None
         k = self._keys[hand]
         if k is None:

@@ -142,6 +142,11 @@ class WindowedPlan(Generic[S]):
     def forget(self) -> None:
         self._steps = None
 
+    def held(self) -> list[S] | None:
+        """The steps kept for the pending groups from the first on (None when none):
+        what the next commit fixes unless a note arrives first.  Read only."""
+        return list(self._steps) if self._steps else None
+
     def step(
         self,
         groups: list[list[R]],

@@ -22,6 +22,8 @@ from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld
 from virja.plan.config import DrumNote
+from virja.plan.types import PlannedNote
+from virja.vocab import DrumStroke, as_limb, as_piece
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
 # double trigger): the later ones ride on the first stroke, each at its own time.
@@ -141,6 +143,9 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
+        # the last solve's inputs and result: a provisional look (:meth:`provisional`)
+        # solves what the next commit would, which then takes it instead of solving again
+        self._solved: tuple[tuple[object, ...], list[HandStep]] | None = None
 
     def kind(self, drum: DrumNote) -> str:
         return drum.piece
@@ -148,13 +153,14 @@ class HandsChain(DrumChain):
     def forget_plan(self) -> None:
         self.plan.forget()
 
-    def _rebounds(self, groups: list[list[DrumHeld]]) -> set[int]:
+    def _rebounds(self, groups: list[list[DrumHeld]], decide: bool = True) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
         note on the same piece, fixed or pending, within its ``min_interval_s`` (a
         buzz: soft rebounds of one pressed stroke), and, at any velocity, those
         within SAME_STROKE_S of an earlier note on the piece in an earlier group (one
         stroke heard twice, split by the grouping window; in one group the same rule
-        makes them one stroke)."""
+        makes them one stroke).  ``decide``: each note's decision is kept (taken once);
+        otherwise an undecided note is only looked at (:meth:`provisional`)."""
         strokes: dict[str, list[float]] = {}
         group_of = {r.seq: gi for gi, g in enumerate(groups) for r in g}
         earlier: dict[str, list[tuple[float, int]]] = {}  # piece: (time, group), -1 fixed
@@ -165,42 +171,64 @@ class HandsChain(DrumChain):
         for r in self.pending:
             strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
             earlier.setdefault(r.drum.piece, []).append((r.note.time_s, group_of.get(r.seq, -2)))
+        out: set[int] = set()
         for r in self.pending:
-            if r.rebound is not None:
-                continue
-            t, gi = r.note.time_s, group_of.get(r.seq, -2)
-            r.rebound = any(
-                0 < t - s <= SAME_STROKE_S + GROUP_EPS_S and g != gi
-                for s, g in earlier.get(r.drum.piece, ())
-            )
-            if r.rebound:
-                continue
-            if r.note.velocity >= BUZZ_VELOCITY:
-                continue
-            if r.drum.piece not in BUZZ_PIECES:  # a crash swings away: no rebound
-                continue
-            t = r.note.time_s
-            reach = self.ctx.config.timing.get(r.drum.piece).min_interval_s
-            if r.note.velocity >= REBOUND_VELOCITY:
-                reach = max(reach, BUZZ_S)
-            r.rebound = any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ()))
-        return {r.seq for r in self.pending if r.rebound}
+            rebound = r.rebound
+            if rebound is None:
+                rebound = self._is_rebound(r, group_of.get(r.seq, -2), strokes, earlier)
+                if decide:
+                    r.rebound = rebound
+            if rebound:
+                out.add(r.seq)
+        return out
 
-    def _decide_foot(self, group: list[DrumHeld], rebounds: set[int]) -> None:
+    def _is_rebound(
+        self,
+        r: DrumHeld,
+        gi: int,
+        strokes: dict[str, list[float]],
+        earlier: dict[str, list[tuple[float, int]]],
+    ) -> bool:
+        """The rule of :meth:`_rebounds` for one undecided note of group ``gi``."""
+        t = r.note.time_s
+        if any(
+            0 < t - s <= SAME_STROKE_S + GROUP_EPS_S and g != gi
+            for s, g in earlier.get(r.drum.piece, ())
+        ):
+            return True
+        if r.note.velocity >= BUZZ_VELOCITY:
+            return False
+        if r.drum.piece not in BUZZ_PIECES:  # a crash swings away: no rebound
+            return False
+        reach = self.ctx.config.timing.get(r.drum.piece).min_interval_s
+        if r.note.velocity >= REBOUND_VELOCITY:
+            reach = max(reach, BUZZ_S)
+        return any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ()))
+
+    def _decide_foot(
+        self, group: list[DrumHeld], rebounds: set[int], decide: bool = True
+    ) -> set[int]:
         """Three or more hand pieces at once, one the hi-hat: the left foot takes the
-        hi-hat (a chick) if it is free, and the hands keep the rest."""
+        hi-hat (a chick) if it is free, and the hands keep the rest.  Returns the
+        group's notes given to the foot; ``decide`` as in :meth:`_rebounds`."""
         undecided = [r for r in group if r.to_foot is None]
+        out = {r.seq for r in group if r.to_foot}
         if not undecided:
-            return
+            return out
         pieces = {r.drum.piece for r in group if r.seq not in rebounds}
         crowded = len(pieces) >= 3 and "hihat" in pieces
         for r in undecided:
-            r.to_foot = (
+            to_foot = (
                 crowded
                 and r.seq not in rebounds
                 and r.drum.piece == "hihat"
                 and self.foot.can_chick(r.note.time_s)
             )
+            if decide:
+                r.to_foot = to_foot
+            if to_foot:
+                out.add(r.seq)
+        return out
 
     def fix_groups(self, groups: list[list[DrumHeld]], n_groups: int) -> None:
         rebounds = self._rebounds(groups)
@@ -219,20 +247,74 @@ class HandsChain(DrumChain):
             return hp
 
         def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
-            sol = drums_mod.solve(
-                self.ctx.config.costs,
-                self.ctx.config.timing,
-                self.state,
-                [prepare(g).group for g in win],
-                beam=self.ctx.bounds.beam,
-            )
-            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+            return self._solve([prepare(g).group for g in win])
 
         for gi in range(n_groups):
             hp = prepare(groups[gi])
             assignment, stroke_costs, state = self.plan.step(groups, gi, solve)
             self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
             self.state = state
+
+    def _solve(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
+        """:func:`virja.plan.drums.solve` of ``groups`` from the chain's state; the
+        result of the same inputs solved last (by :meth:`provisional`) is taken
+        as it is (the solver is a pure function of them: the plan is the same)."""
+        key = (self.state, tuple(groups))
+        if self._solved is not None and self._solved[0] == key:
+            return list(self._solved[1])
+        sol = drums_mod.solve(
+            self.ctx.config.costs,
+            self.ctx.config.timing,
+            self.state,
+            groups,
+            beam=self.ctx.bounds.beam,
+        )
+        steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+        self._solved = (key, steps)
+        return list(steps)
+
+    def provisional(self) -> list[PlannedNote]:
+        """The hand each pending note would get if nothing more arrived: the plan of the
+        pending groups as the next commit would fix it (the steps the chain holds,
+        else one solve of the first window, kept for that commit), as planned notes
+        not yet fixed (``cost`` 0).  Changes nothing: no note's decision is taken,
+        nothing is fixed or emitted.  Rebounds of earlier strokes and hi-hat notes
+        for the left foot are left out (their limb is not the solver's choice)."""
+        if not self.pending:
+            return []
+        groups = self.groups()
+        rebounds = self._rebounds(groups, decide=False)
+        aside = set(rebounds)
+        for g in groups:
+            aside |= self._decide_foot(g, rebounds, decide=False)
+        held = self.plan.held()
+        n = min(len(groups), len(held) if held else self.ctx.bounds.window_groups)
+        hps = [
+            hand_group([r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick)
+            for g in groups[:n]
+        ]
+        steps = held if held else self._solve([hp.group for hp in hps])
+        out: list[PlannedNote] = []
+        for hp, (assignment, _costs, _state) in zip(hps, steps, strict=False):
+            if len(assignment) != len(hp.group.strokes):
+                continue
+            for si, stroke in enumerate(hp.group.strokes):
+                hand = assignment[si]
+                other = 1 - si
+                if (
+                    hand is None
+                    and len(assignment) == 2
+                    and hp.group.strokes[other].piece == (stroke.piece)
+                ):
+                    hand = assignment[other]  # a rebound of the other stroke
+                if hand is None:
+                    continue
+                recs = hp.kept[si]
+                now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
+                rest = recs[len(now) :] + [r for k, c in hp.bounces if k == si for r in c]
+                out.extend(_unfixed(r, stroke.piece, hand, now[0]) for r in now)
+                out.extend(_unfixed(r, stroke.piece, hand, r) for r in rest)
+        return out
 
     def _fix_group(
         self,
@@ -312,3 +394,26 @@ class HandsChain(DrumChain):
             return
         cost, hand = min(choices)
         self.emit_stroke([rec], rec.drum.piece, hand, cost)
+
+
+def _unfixed(rec: DrumHeld, piece: str, hand: str, timed: DrumHeld) -> PlannedNote:
+    """``rec`` as a planned note not yet fixed: struck by ``hand`` on ``piece`` with the
+    start and impact of ``timed`` (the stroke's first note, or itself)."""
+    n = rec.note
+    stroke = DrumStroke(as_piece(piece), as_limb(hand))
+    return PlannedNote(
+        time=n.time_s,
+        performer=rec.performer,
+        channel=n.channel,
+        note=rec.played,
+        velocity=n.velocity,
+        limb=stroke.limb,
+        piece=stroke.piece,
+        string=None,
+        fret=None,
+        motion=stroke,
+        start=timed.start,
+        impact=timed.impact,
+        cost=0.0,
+        late=timed.late,
+    )

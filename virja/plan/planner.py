@@ -95,6 +95,7 @@ class OnlinePlanner:
         right_foot = FootChain(ctx, "right_foot")
         left_foot = FootChain(ctx, "left_foot")
         hands = HandsChain(ctx, left_foot)
+        self._hands = hands
         # a drum note's chain by its kit limb (None: a hand, chosen by cost)
         self._kit = {None: hands, "right_foot": right_foot, "left_foot": left_foot}
         # in this order each call fixes them (a hand's hi-hat may go to the left foot)
@@ -147,6 +148,21 @@ class OnlinePlanner:
         ready = [p for p in outbox if p.start <= now_s]
         self._ledger.outbox = [p for p in outbox if p.start > now_s]
         return sorted(ready, key=lambda p: (p.start, p.time))
+
+    def provisional(self) -> list[PlannedNote]:
+        """The drummer's hand notes not yet handed out by :meth:`poll`, each with the hand
+        the plan gives it now (:meth:`virja.plan.chain_hands.HandsChain.provisional`;
+        a note fixed already as fixed), in impact order.
+        Call it after :meth:`add_note` or :meth:`poll`: a later note may revise it;
+        the plan fixed at the motion's start is what :meth:`poll` returns.  Looking
+        changes no plan (the same notes are fixed the same way whether or not it is
+        called); its solve is the one the next commit would do, kept for it."""
+        fixed = [  # fixed already, not handed out yet (poll): as they will be
+            p for p in self._ledger.outbox if p.performer == "drums" and p.limb.endswith("_hand")
+        ]
+        out = fixed + self._hands.provisional()
+        out.sort(key=lambda p: (p.impact, p.time, p.limb, p.note))
+        return out
 
     def flush(self) -> list[PlannedNote]:
         """Everything still held, planned and fixed, in start order."""

@@ -313,6 +313,9 @@ class _Deferred:
     def note_known(self, performer: object, note: object, at_s: float) -> None:
         self.calls.append(("note_known", (performer, note, at_s)))
 
+    def note_provisional(self, notes: object) -> None:
+        self.calls.append(("note_provisional", (notes,)))
+
     def set_articulations(self, articulations: object) -> None:
         self.calls.append(("set_articulations", (articulations,)))
 

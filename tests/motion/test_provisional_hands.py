@@ -1,0 +1,166 @@
+"""The drummer's provisional hands (BandAnimator.note_provisional): a hand moves toward
+a note from when it is known, before its plan is fixed; a revised plan changes no frame
+drawn and re-targets the hands from where they are."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from tests.motion.helpers import drum
+from virja.events import NoteOn
+from virja.motion.band import BandAnimator
+from virja.motion.clip import MotionLibrary
+from virja.motion.drummer_body import BodySettings
+from virja.motion.drummer_hands import HandSettings
+from virja.motion.metrics import contact_distance
+from virja.motion.skeleton import SKELETON
+from virja.plan.types import PlannedNote
+
+LEAD = 0.06  # the planned lead at 300 bpm: too short to cross the kit
+
+
+def _note(motion: str, impact: float, note: int, velocity: int = 90) -> PlannedNote:
+    return replace(drum(motion, impact - LEAD, impact, velocity), note=note, time=impact)
+
+
+def _animator(library: MotionLibrary) -> BandAnimator:
+    return BandAnimator(library, body=BodySettings.still(), hands=HandSettings())
+
+
+def _wrists(a: BandAnimator, ts: np.ndarray) -> np.ndarray:
+    """Both wrists (m, 2, 3) [left, right] at ``ts``."""
+    pos, _ = SKELETON.fk(a.local_rotations_many(ts), a._roots)
+    return pos[:, 0, [SKELETON.index("LeftHand"), SKELETON.index("RightHand")]]
+
+
+def _known(a: BandAnimator, p: PlannedNote, at: float) -> None:
+    a.note_known("drums", NoteOn(p.time, p.channel, p.note, p.velocity), at)
+
+
+def _play(
+    library: MotionLibrary, fixed: list[PlannedNote], shown: list[tuple[float, list[PlannedNote]]]
+) -> tuple[BandAnimator, np.ndarray, np.ndarray]:
+    """A live window at 60 fps: notes known a beat (0.5 s) ahead, the provisional sets
+    ``shown`` told at their times, the fixed plans at their starts; returns the
+    animator, the frame times and the frames as drawn."""
+    ts = np.arange(0.2, 4.0, 1 / 60)
+    a = _animator(library)
+    events: list[tuple[float, int, object]] = [(p.impact - 0.5, 0, p) for p in fixed]
+    events += [(at, 1, notes) for at, notes in shown]
+    events += [(p.start, 2, p) for p in fixed]
+    events.sort(key=lambda e: (e[0], e[1]))
+    drawn, k = [], 0
+    for t in ts:
+        while k < len(events) and events[k][0] <= t:
+            at, kind, what = events[k]
+            if kind == 0:
+                _known(a, what, at)  # type: ignore[arg-type]
+            elif kind == 1:
+                a.note_provisional(what)  # type: ignore[arg-type]
+            else:
+                a.add_planned(what)  # type: ignore[arg-type]
+            k += 1
+        drawn.append(a.local_rotations(float(t)))
+        a.mark_drawn(float(t))
+    return a, ts, np.array(drawn)
+
+
+def _same_frames(a: BandAnimator, ts: np.ndarray, drawn: np.ndarray) -> None:
+    again = a.local_rotations_many(ts)
+    np.testing.assert_allclose(np.abs(np.sum(again * drawn, axis=-1)), 1.0, atol=1e-9)
+
+
+def test_a_provisional_hand_leaves_when_the_note_is_known(library: MotionLibrary) -> None:
+    """Ride, then the floor tom 0.4 s later planned with a 60 ms lead: told the
+    provisional hand when the tom is known, the right hand crosses in time (under
+    5 m/s, no 15 cm jump at 30 fps); without it, it crosses in the lead."""
+    ride = _note("ride_right_hand", 1.0, 51)
+    tom = _note("tom_floor_right_hand", 1.4, 41)
+    peaks = []
+    for told in (True, False):
+        shown = [(0.5, [ride]), (0.9, [ride, tom])] if told else []
+        a, ts, drawn = _play(library, [ride, tom], shown)
+        _same_frames(a, ts, drawn)
+        fine = np.arange(0.3, 2.0, 1 / 120)
+        w = _wrists(a, fine)[:, 1]
+        speed = np.linalg.norm(np.diff(w, axis=0), axis=1) * 120
+        jump = np.linalg.norm(w[4:] - w[:-4], axis=1).max()
+        peaks.append((speed.max(), jump))
+        for p in (ride, tom):
+            assert contact_distance(a, p, p.impact)[0] < 1e-4
+        assert a.provisional_counts["fixed_same"] == (2 if told else 0)
+    (fast, jump_told), (slow, jump_late) = peaks
+    assert fast <= 5.0 and jump_told <= 0.15
+    assert slow > 8.0 and jump_late > 0.15  # the case this fixes
+
+
+def test_the_plan_fixing_the_shown_hand_changes_nothing(library: MotionLibrary) -> None:
+    """Told the provisional hand and then the same plan fixed: the motion is the one
+    shown (every frame, before and after the fix), contacts exact."""
+    notes = [_note("snare_left_hand", 1.0, 38), _note("crash_right_hand", 1.5, 49)]
+    a, ts, drawn = _play(library, notes, [(0.5, notes[:1]), (1.0, notes[1:])])
+    _same_frames(a, ts, drawn)
+    b = _animator(library)  # the whole input known: render's default, motion-report
+    for p in notes:
+        b.add_planned(p, known_at=p.impact - 0.5)
+    np.testing.assert_allclose(
+        np.abs(np.sum(b.local_rotations_many(ts) * drawn, axis=-1)), 1.0, atol=1e-9
+    )
+    assert a.provisional_counts["fixed_same"] == 2
+    for p in notes:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4
+
+
+def test_a_revised_hand_changes_no_frame_drawn_and_moves_on_from_where_it_is(
+    library: MotionLibrary,
+) -> None:
+    """The crash is shown to the right hand when known, then the plan fixes the left:
+    every frame drawn stays as drawn, the right hand turns back from where it was and
+    the left goes, both without a jump, and the crash is struck exactly by the left."""
+    shown = _note("crash_right_hand", 1.5, 49)
+    fixed = _note("crash_left_hand", 1.5, 49)
+    a, ts, drawn = _play(library, [fixed], [(1.0, [shown])])
+    _same_frames(a, ts, drawn)
+    assert a.provisional_counts["fixed_other"] == 1
+    assert contact_distance(a, fixed, fixed.impact)[0] < 1e-4
+    w = _wrists(a, np.arange(0.9, 2.0, 1 / 120))
+    speed = np.linalg.norm(np.diff(w, axis=0), axis=-1) * 120
+    assert speed[:, 1].max() < 5.0  # the right hand turns back at a walk
+    right_moved = np.linalg.norm(w[:, 1] - w[0, 1], axis=-1).max()
+    assert right_moved > 0.02  # it had started toward the crash
+    # the left hand learns at the motion's start (its 60 ms lead): fast, but it
+    # leaves from where it is, no step at the frame where its course changed
+    at = int(round((fixed.start - 0.9) * 120))
+    assert speed[at - 2 : at + 1, 0].max() < 5.0
+
+
+def test_a_provisional_hand_revised_before_its_plan_and_taken_back(
+    library: MotionLibrary,
+) -> None:
+    """Shown right, then left (a later note changed the plan), then taken back (the
+    note left the set, as a dropped one): the frames drawn stay, the hands settle."""
+    right = _note("tom_high_right_hand", 1.6, 48)
+    left = _note("tom_high_left_hand", 1.6, 48)
+    a, ts, drawn = _play(library, [], [(1.1, [right]), (1.3, [left]), (1.45, [])])
+    _same_frames(a, ts, drawn)
+    assert a.provisional_counts["revised"] == 1
+    assert a.provisional_counts["taken_back"] == 1
+    w = _wrists(a, np.arange(1.0, 4.0, 1 / 120))
+    assert np.linalg.norm(np.diff(w, axis=0), axis=-1).max() * 120 < 8.0
+
+
+def test_with_nothing_drawn_the_provisional_hands_leave_no_trace(library: MotionLibrary) -> None:
+    """The whole input known (nothing drawn): told provisional hands, revised and taken
+    back, the motion is exactly that of the fixed plan alone."""
+    fixed = [_note("ride_right_hand", 1.0, 51), _note("crash_left_hand", 1.5, 49)]
+    a = _animator(library)
+    b = _animator(library)
+    a.note_provisional([_note("crash_right_hand", 1.5, 49), _note("snare_left_hand", 1.2, 38)])
+    a.note_provisional([fixed[1]])
+    for p in fixed:
+        a.add_planned(p)
+        b.add_planned(p)
+    ts = np.arange(0.2, 3.0, 1 / 60)
+    np.testing.assert_array_equal(a.local_rotations_many(ts), b.local_rotations_many(ts))

@@ -14,6 +14,7 @@ left foot (:meth:`virja.plan.chain_feet.FootChain.chick`).  Shared rules:
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -33,6 +34,8 @@ SAME_STROKE_S = 0.010
 BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
 BUZZ_S = 0.050
 BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
+
+_MARGIN_S = 1e-6  # the rebound rules look at notes this much further back, then test exactly
 
 # one solved group: the hand per stroke (None: dropped), their costs, the state after
 HandStep = tuple[drums_mod.Assignment, tuple[float, ...], drums_mod.HandState]
@@ -143,9 +146,9 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
-        # the last solve's inputs and result: a provisional look (:meth:`provisional`)
-        # solves what the next commit would, which then takes it instead of solving again
-        self._solved: tuple[tuple[object, ...], list[HandStep]] | None = None
+        # the steps of the latest solves by group time, with the group and the state
+        # it was solved from: what :meth:`provisional` reuses rather than solving again
+        self._seen: dict[float, tuple[drums_mod.HandGroup, drums_mod.HandState, HandStep]] = {}
 
     def kind(self, drum: DrumNote) -> str:
         return drum.piece
@@ -161,16 +164,26 @@ class HandsChain(DrumChain):
         stroke heard twice, split by the grouping window; in one group the same rule
         makes them one stroke).  ``decide``: each note's decision is kept (taken once);
         otherwise an undecided note is only looked at (:meth:`provisional`)."""
+        need = {r.drum.piece for r in self.pending if r.rebound is None}
+        if not need:  # every note decided already
+            return {r.seq for r in self.pending if r.rebound}
         strokes: dict[str, list[float]] = {}
         group_of = {r.seq: gi for gi, g in enumerate(groups) for r in g}
         earlier: dict[str, list[tuple[float, int]]] = {}  # piece: (time, group), -1 fixed
         for ft, p in self.fixed:
-            if p.piece is not None:
+            if p.piece in need:
                 strokes.setdefault(p.piece, []).append(ft)
                 earlier.setdefault(p.piece, []).append((ft, -1))
         for r in self.pending:
-            strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
-            earlier.setdefault(r.drum.piece, []).append((r.note.time_s, group_of.get(r.seq, -2)))
+            if r.drum.piece in need:
+                strokes.setdefault(r.drum.piece, []).append(r.note.time_s)
+                earlier.setdefault(r.drum.piece, []).append(
+                    (r.note.time_s, group_of.get(r.seq, -2))
+                )
+        for times in strokes.values():  # sorted: a note looks only at those just before it
+            times.sort()
+        for pairs in earlier.values():
+            pairs.sort()
         out: set[int] = set()
         for r in self.pending:
             rebound = r.rebound
@@ -191,10 +204,11 @@ class HandsChain(DrumChain):
     ) -> bool:
         """The rule of :meth:`_rebounds` for one undecided note of group ``gi``."""
         t = r.note.time_s
-        if any(
-            0 < t - s <= SAME_STROKE_S + GROUP_EPS_S and g != gi
-            for s, g in earlier.get(r.drum.piece, ())
-        ):
+        # the notes within a window a little wider than the rule's, then the rule itself
+        pairs = earlier.get(r.drum.piece, [])
+        lo = bisect.bisect_left(pairs, (t - SAME_STROKE_S - GROUP_EPS_S - _MARGIN_S,))
+        near = pairs[lo : bisect.bisect_left(pairs, (t,), lo)]
+        if any(0 < t - s <= SAME_STROKE_S + GROUP_EPS_S and g != gi for s, g in near):
             return True
         if r.note.velocity >= BUZZ_VELOCITY:
             return False
@@ -203,7 +217,11 @@ class HandsChain(DrumChain):
         reach = self.ctx.config.timing.get(r.drum.piece).min_interval_s
         if r.note.velocity >= REBOUND_VELOCITY:
             reach = max(reach, BUZZ_S)
-        return any(0 < t - s <= reach + GROUP_EPS_S for s in strokes.get(r.drum.piece, ()))
+        times = strokes.get(r.drum.piece, [])
+        lo = bisect.bisect_left(times, t - reach - GROUP_EPS_S - _MARGIN_S)
+        return any(
+            0 < t - s <= reach + GROUP_EPS_S for s in times[lo : bisect.bisect_left(times, t, lo)]
+        )
 
     def _decide_foot(
         self, group: list[DrumHeld], rebounds: set[int], decide: bool = True
@@ -247,7 +265,17 @@ class HandsChain(DrumChain):
             return hp
 
         def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
-            return self._solve([prepare(g).group for g in win])
+            hgs = [prepare(g).group for g in win]
+            sol = drums_mod.solve(
+                self.ctx.config.costs,
+                self.ctx.config.timing,
+                self.state,
+                hgs,
+                beam=self.ctx.bounds.beam,
+            )
+            steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+            self._remember(hgs, self.state, steps)
+            return steps
 
         for gi in range(n_groups):
             hp = prepare(groups[gi])
@@ -255,29 +283,21 @@ class HandsChain(DrumChain):
             self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
             self.state = state
 
-    def _solve(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
-        """:func:`virja.plan.drums.solve` of ``groups`` from the chain's state; the
-        result of the same inputs solved last (by :meth:`provisional`) is taken
-        as it is (the solver is a pure function of them: the plan is the same)."""
-        key = (self.state, tuple(groups))
-        if self._solved is not None and self._solved[0] == key:
-            return list(self._solved[1])
-        sol = drums_mod.solve(
-            self.ctx.config.costs,
-            self.ctx.config.timing,
-            self.state,
-            groups,
-            beam=self.ctx.bounds.beam,
-        )
-        steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-        self._solved = (key, steps)
-        return list(steps)
+    def _remember(
+        self, groups: list[drums_mod.HandGroup], state: drums_mod.HandState, steps: list[HandStep]
+    ) -> None:
+        """Keep solved ``steps`` of ``groups`` (solved from ``state``) for :meth:`provisional`."""
+        if len(self._seen) > 8 * self.ctx.bounds.window_groups:
+            self._seen.clear()
+        for g, step in zip(groups, steps, strict=True):
+            self._seen[g.time] = (g, state, step)
+            state = step[2]
 
     def provisional(self) -> list[PlannedNote]:
-        """The hand each pending note would get if nothing more arrived: the plan of the
-        pending groups as the next commit would fix it (the steps the chain holds,
-        else one solve of the first window, kept for that commit), as planned notes
-        not yet fixed (``cost`` 0).  Changes nothing: no note's decision is taken,
+        """The hand each pending note would get if nothing more arrived, as planned notes
+        not yet fixed (``cost`` 0): the plan the chain holds for the pending groups
+        (what the next commit fixes), else the latest solve's plan of the groups it
+        saw, continued over the groups new notes made (:meth:`_continued`).  Changes nothing: no note's decision is taken,
         nothing is fixed or emitted.  Rebounds of earlier strokes and hi-hat notes
         for the left foot are left out (their limb is not the solver's choice)."""
         if not self.pending:
@@ -293,7 +313,7 @@ class HandsChain(DrumChain):
             hand_group([r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick)
             for g in groups[:n]
         ]
-        steps = held if held else self._solve([hp.group for hp in hps])
+        steps = held if held else self._continued([hp.group for hp in hps])
         out: list[PlannedNote] = []
         for hp, (assignment, _costs, _state) in zip(hps, steps, strict=False):
             if len(assignment) != len(hp.group.strokes):
@@ -315,6 +335,34 @@ class HandsChain(DrumChain):
                 out.extend(_unfixed(r, stroke.piece, hand, now[0]) for r in now)
                 out.extend(_unfixed(r, stroke.piece, hand, r) for r in rest)
         return out
+
+    def _continued(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
+        """Steps for ``groups`` (the pending ones, from the chain's state): those of the
+        latest solve while its groups and states are the same, then a solve of the
+        rest from there (usually the one group a new note made).  Cheap, and a plan
+        only to look at: the commit solves its window as always."""
+        self._seen = {t: v for t, v in self._seen.items() if t >= groups[0].time}
+        state = self.state
+        steps: list[HandStep] = []
+        for g in groups:
+            seen = self._seen.get(g.time)
+            if seen is None or seen[0] != g or seen[1] != state:
+                break
+            steps.append(seen[2])
+            state = seen[2][2]
+        rest = groups[len(steps) :]
+        if rest:
+            sol = drums_mod.solve(
+                self.ctx.config.costs,
+                self.ctx.config.timing,
+                state,
+                rest,
+                beam=self.ctx.bounds.beam,
+            )
+            more = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+            self._remember(rest, state, more)
+            steps += more
+        return steps
 
     def _fix_group(
         self,

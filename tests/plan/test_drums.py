@@ -149,8 +149,8 @@ def _objective(config: PlanConfig, groups: list[HandGroup], assigns: list[tuple]
     for k, (t, h, piece) in enumerate(seq):
         if h in last and t - last[h][0] < timing.stretch_gap(last[h][1], piece) - 1e-9:
             return None
-        if h in last and t - last[h][0] < timing.gap(last[h][1], piece) - 1e-9:
-            total += timing.stretch_penalty  # the hand at a stretch
+        if h in last:  # the hand at a stretch, at speed
+            total += drums.stroke_penalty(timing, last[h][1], piece, t - last[h][0])
         last[h] = (t, piece)
         if k == 0 or t - seq[k - 1][0] >= timing.rest_s:
             row = c.none_row

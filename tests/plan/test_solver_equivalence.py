@@ -49,7 +49,7 @@ def _reference_drums(
             prev, prev_t, t_right, t_left, p_right, p_left = st
             row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
             for k, (_assign, played, penalty) in enumerate(compiled):
-                # feasible at all (stretch_gap), and at a stretch (gap) for how many
+                # feasible at all (stretch_gap), and what each stroke pays for stretch and speed
                 ok, stretched = True, penalty
                 for is_right, _m, piece, i in played:
                     last, lp = (t_right, p_right) if is_right else (t_left, p_left)
@@ -57,8 +57,8 @@ def _reference_drums(
                     eps = drums.TIME_EPS_S
                     if last is not None and ts - last < timing.stretch_gap(lp, piece) - eps:
                         ok = False
-                    elif last is not None and ts - last < timing.gap(lp, piece) - eps:
-                        stretched = stretched + timing.stretch_penalty
+                    elif last is not None:  # at a stretch, at speed
+                        stretched = stretched + drums.stroke_penalty(timing, lp, piece, ts - last)
                 row, tr, tl, total = row0, t_right, t_left, acc + stretched
                 pr, pl = p_right, p_left
                 for is_right, m, piece, i in played:
@@ -150,6 +150,11 @@ def _random_case(
             stretch_interval_s=floor,
             stretch_moves=rng.choice([{}, config.timing.stretch_moves]),
             stretch_penalty=rng.choice([0.0, 0.5, 150.0]),
+        )
+    if rng.random() < 0.5:  # the hand's speed tiers: none, the shipped ones, odd ones
+        tiers = rng.choice([(), config.timing.speed_tiers, ((2.0, 0.5), (5.0, 3.0), (9.0, 0.1))])
+        timing = dataclasses.replace(
+            timing, speed_tiers=tiers, distances=rng.choice([{}, config.timing.distances])
         )
     state = drums.START
     if rng.random() < 0.3:  # a fixed state left by an earlier plan

@@ -53,6 +53,11 @@ _UP = np.array([0.0, 1.0, 0.0])
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
 _MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
 _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
+# a move the plan squeezes (no time to hover first): constant speed between two short
+# ramps of this share each, so the peak speed is 1 / (1 - _RAMP) of the average (1.25;
+# smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
+_SQUEEZED, _RAMP = 4, 0.2
+_SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
 
 
 @dataclass(frozen=True)
@@ -179,9 +184,27 @@ def _shaped(
     u = np.where(t < keys_t[0], 0.0, u)
     prof = profile[i1]
     u = np.where(
-        prof == _ACCEL, u * u, np.where(prof == _DECEL, 1.0 - (1.0 - u) ** 2, u * u * (3 - 2 * u))
+        prof == _ACCEL,
+        u * u,
+        np.where(
+            prof == _DECEL,
+            1.0 - (1.0 - u) ** 2,
+            np.where(prof == _SQUEEZED, _ramped(u), u * u * (3 - 2 * u)),
+        ),
     )
     return i0, i1, u
+
+
+def _ramped(u: np.ndarray) -> np.ndarray:
+    """The fraction along a :data:`_SQUEEZED` move: ramps of ``_RAMP`` at either end at
+    constant acceleration, constant speed ``1 / (1 - _RAMP)`` between (continuous
+    speed, no step in position)."""
+    v = 1.0 / (1.0 - _RAMP)
+    return np.where(
+        u < _RAMP,
+        0.5 * v * u * u / _RAMP,
+        np.where(u > 1.0 - _RAMP, 1.0 - 0.5 * v * (1.0 - u) ** 2 / _RAMP, v * (u - 0.5 * _RAMP)),
+    )
 
 
 def _shape(u: float, profile: int) -> float:
@@ -189,15 +212,22 @@ def _shape(u: float, profile: int) -> float:
         return u * u
     if profile == _DECEL:
         return 1.0 - (1.0 - u) ** 2
+    if profile == _SQUEEZED:
+        return float(_ramped(np.asarray(u)))
     return u * u * (3 - 2 * u)
 
 
-def _height_share(u: np.ndarray, rise: np.ndarray, moving: np.ndarray) -> np.ndarray:
+def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.ndarray:
     """How far along its move the grip's height is at shaped fraction ``u``: a hand going
     down stays up until late (off a cymbal over its edge, not under it); on a move
-    given its full time (``moving``) a hand going up also rises first; all start and
-    end at rest."""
-    lead = np.where(moving, 1.0 - (1.0 - u) ** _RISE_LEAD, u)
+    given its full time (:data:`_MOVE`) a hand going up also rises first, on a
+    squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first;
+    all start and end at rest."""
+    lead = np.where(
+        profile == _MOVE,
+        1.0 - (1.0 - u) ** _RISE_LEAD,
+        np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+    )
     return np.where(rise > 0, lead, u**_DROP_LAG)
 
 
@@ -205,7 +235,7 @@ def _pose_at(a: np.ndarray, b: np.ndarray, u: float, shape: int) -> np.ndarray:
     """(grip, rot, elbow) rows ``a`` -> ``b`` at shaped fraction ``u`` of a ``shape`` segment."""
     out = a + u * (b - a)
     dy = np.asarray(b[1] - a[1])
-    out[1] = a[1] + float(_height_share(np.asarray(u), dy, np.asarray(shape == _MOVE))) * dy
+    out[1] = a[1] + float(_height_share(np.asarray(u), dy, np.asarray(shape))) * dy
     out[3:7] = quat.slerp(a[3:7], b[3:7], u)
     return out
 
@@ -490,8 +520,8 @@ class DrummerHands:
             if leave > cut + 1e-4:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
                 _add(pt, pv, pp, t, target, _MOVE)  # time enough: over the cymbals' edges
-            else:  # squeezed by the plan: the straight, shortest way
-                _add(pt, pv, pp, t, target, _SMOOTH)
+            else:  # squeezed by the plan: the straight, shortest way at even speed
+                _add(pt, pv, pp, t, target, _SQUEEZED)
             rebound = -math.inf  # when the last stroke's rebound is over
             if prev_t is not None:
                 rebound = prev_t + min(s.rebound_max_s, s.rebound_share * gap)
@@ -591,7 +621,7 @@ class DrummerHands:
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
         dy = end[:, 1] - k.grip[i0, 1]
-        grip[:, 1] = k.grip[i0, 1] + _height_share(u, dy, k.profile[i1] == _MOVE) * dy
+        grip[:, 1] = k.grip[i0, 1] + _height_share(u, dy, k.profile[i1]) * dy
         elbow = k.elbow[i0] + u[:, None] * (end[:, 7:] - k.elbow[i0])
         rot = quat.slerp(k.rot[i0], end[:, 3:7], u)
         j0, j1, w = _shaped(k.lift_t, k.lift_profile, t, k.lift_end_t)

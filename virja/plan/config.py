@@ -198,6 +198,11 @@ class Timing:
     stretch_interval_s: float | None = None
     stretch_moves: dict[tuple[str, str], float] = field(default_factory=dict)
     stretch_penalty: float = 0.0
+    # the hand's speed (timing.toml [hand_speed]): a stroke on another piece than the
+    # hand's last costs the penalty of the fastest tier ``(speed_m_s, penalty)`` whose
+    # speed the move needs (``distances[(prev, piece)]`` / time since the last stroke)
+    speed_tiers: tuple[tuple[float, float], ...] = ()
+    distances: dict[tuple[str, str], float] = field(default_factory=dict)
 
     def get(self, kind: str) -> MotionTiming:
         try:
@@ -226,29 +231,46 @@ class Timing:
             return min(normal, floor)
         return min(normal, max(floor, self.stretch_moves.get((prev, piece), 0.0)))
 
+    def penalty_steps(self, prev: str | None, piece: str) -> tuple[tuple[float, float], ...]:
+        """``(time, penalty)`` pairs, the largest penalty first: a stroke on ``piece`` less
+        than ``time`` after the hand's stroke on ``prev`` costs at least ``penalty``.  At
+        a stretch (sooner than :meth:`gap`) ``stretch_penalty``; on another piece, each
+        speed tier whose speed the move needs (``distance / time`` above ``speed_m_s``)."""
+        steps = [(self.gap(prev, piece), self.stretch_penalty)] if self.stretch_penalty else []
+        if prev is not None and prev != piece:
+            dist = self.distances.get((prev, piece), 0.0)
+            steps += [(dist / speed, pen) for speed, pen in self.speed_tiers if pen and dist]
+        return tuple(sorted(steps, key=lambda s: (-s[1], -s[0])))
+
     @property
     def max_gap(self) -> float:
-        """The longest :meth:`gap`: a stroke older than this constrains nothing."""
+        """The longest :meth:`gap` or speed tier's time: a stroke older than this
+        constrains nothing and costs nothing."""
+        slowest = min((speed for speed, _pen in self.speed_tiers), default=math.inf)
         return max(
             max((mt.min_interval_s for mt in self.kinds.values()), default=0.0),
             max(self.moves.values(), default=0.0),
+            max(self.distances.values(), default=0.0) / slowest,
         )
+
+
+def hand_distances() -> dict[tuple[str, str], float]:
+    """The distance (m) between the strike points of every two hand pieces of the drawn
+    kit (virja.geometry)."""
+    from virja.geometry import GEOMETRY
+
+    kit = GEOMETRY.kit
+    pts = {p: kit.strike_point(p) for p in HAND_PIECES}
+    return {
+        (a, b): float(math.dist(pts[a], pts[b])) for a in HAND_PIECES for b in HAND_PIECES if a != b
+    }
 
 
 def hand_moves(base_s: float, speed_m_s: float) -> dict[tuple[str, str], float]:
     """``base_s`` + distance / ``speed_m_s`` between the strike points of every two hand
     pieces of the drawn kit (virja.geometry): lifting off one piece and landing on the
     other is quick, travelling across the kit is not."""
-    from virja.geometry import GEOMETRY
-
-    kit = GEOMETRY.kit
-    pts = {p: kit.strike_point(p) for p in HAND_PIECES}
-    return {
-        (a, b): base_s + float(math.dist(pts[a], pts[b])) / speed_m_s
-        for a in HAND_PIECES
-        for b in HAND_PIECES
-        if a != b
-    }
+    return {ab: base_s + d / speed_m_s for ab, d in hand_distances().items()}
 
 
 @dataclass(frozen=True)
@@ -306,6 +328,11 @@ class HandStretchTable(Schema):
     penalty: float
 
 
+class HandSpeedTable(Schema):
+    speeds_m_s: list[float]
+    penalties: list[float]
+
+
 MotionTimingTable = schema_of(MotionTiming)
 
 
@@ -317,6 +344,7 @@ class TimingFile(Schema):
     motion: dict[str, MotionTimingTable]  # type: ignore[valid-type]
     hand_move: HandMoveTable | None = None
     hand_stretch: HandStretchTable | None = None
+    hand_speed: HandSpeedTable | None = None
 
 
 class PlanTable(Schema):
@@ -445,6 +473,22 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
             stretch_interval_s=st.min_interval_s,
             stretch_moves=hand_moves(st.base_s, st.speed_m_s),
             stretch_penalty=st.penalty,
+        )
+    if (sp := f.hand_speed) is not None:
+        speeds, pens = sp.speeds_m_s, sp.penalties
+        if (
+            len(speeds) != len(pens)
+            or any(v <= 0 for v in speeds)
+            or any(p < 0 for p in pens)
+            or speeds != sorted(set(speeds))
+        ):
+            raise ConfigError(
+                f"{where}: hand_speed needs as many penalties (>= 0) as speeds_m_s (> 0, rising)"
+            )
+        timing = dataclasses.replace(
+            timing,
+            speed_tiers=tuple(zip(speeds, pens, strict=True)),
+            distances=hand_distances(),
         )
     return timing
 

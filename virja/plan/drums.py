@@ -11,7 +11,9 @@ last stroke: the piece's ``min_interval_s`` on the same piece (rebound doubles,
 taps, buzz), longer the farther it has to travel to another piece; at a stretch
 (:meth:`Timing.stretch_gap`: a pressed double, a snap of the wrist) sooner, for
 ``stretch_penalty`` a stroke, as is a flam by one hand or a hi-hat stroke left to
-the foot (:func:`unplayed_penalty`).  A stroke that no hand can make in time is
+the foot (:func:`unplayed_penalty`).  A move to another piece also pays for the speed
+it needs, by tiers (distance / time since the hand's last stroke, timing.toml
+``[hand_speed]``, :func:`stroke_penalty`), so that the hand with time plays.  A stroke that no hand can make in time is
 dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
 when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
 keeps the time).
@@ -104,6 +106,21 @@ def unplayed_penalty(
     return drop_penalty(costs, strokes[i])
 
 
+def _steps(timing: Timing, prev: str | None, piece: str) -> tuple[tuple[float, float], ...]:
+    """:meth:`Timing.penalty_steps` with ``TIME_EPS_S`` taken off each time."""
+    return tuple((time - TIME_EPS_S, pen) for time, pen in timing.penalty_steps(prev, piece))
+
+
+def stroke_penalty(timing: Timing, prev: str | None, piece: str, since: float) -> float:
+    """What a hand's stroke on ``piece`` costs ``since`` seconds after its stroke on
+    ``prev`` (beyond the table): the largest penalty of :meth:`Timing.penalty_steps`
+    whose time it comes sooner than (a stretch, the speed the move needs); 0 if none."""
+    for time, pen in _steps(timing, prev, piece):
+        if since < time:
+            return pen
+    return 0.0
+
+
 def transition(
     costs: DrumCosts, timing: Timing, state: HandState, group: HandGroup, assign: Assignment
 ) -> tuple[float, HandState, tuple[float, ...]] | None:
@@ -115,17 +132,17 @@ def transition(
     prev, prev_t, t_right, t_left, p_right, p_left = state
     t = group.time
     stretch = 0.0
-    for stroke, hand in zip(group.strokes, assign, strict=True):
-        if hand is None:
-            continue
+    for stroke, hand in sorted(
+        ((s, h) for s, h in zip(group.strokes, assign, strict=True) if h is not None),
+        key=lambda sh: sh[1] != LEFT,
+    ):  # left hand first, as the solver adds them
         last, lp = (t_right, p_right) if hand == RIGHT else (t_left, p_left)
         if last is None:
             continue
         since = t + stroke.dt - last
         if since < timing.stretch_gap(lp, stroke.piece) - TIME_EPS_S:
             return None
-        if since < timing.gap(lp, stroke.piece) - TIME_EPS_S:
-            stretch += timing.stretch_penalty
+        stretch += stroke_penalty(timing, lp, stroke.piece, since)
     row = prev if prev is not None and prev_t is not None and t - prev_t < timing.rest_s else None
     order = sorted(
         (i for i, h in enumerate(assign) if h is not None),
@@ -187,22 +204,24 @@ class _Option:
 
 
 # A played option flattened for the solver's inner loop: (option index, the right
-# hand's piece and its stroke's dt (None, 0.0 when the right hand does not play), the
-# least time the right hand needs since its last stroke, by the piece it struck, at a
-# stretch and without (:meth:`Timing.stretch_gap` and :meth:`Timing.gap` less
-# TIME_EPS_S; -inf for every piece when it does not play), the same four for the left
-# hand, motion that ends the group (the next row), penalty, first played motion,
-# table cost first -> second played motion (0.0 for one stroke)).
+# hand's piece and its stroke's dt (None, 0.0 when the right hand does not play), its
+# penalty steps by the piece the hand struck last (:func:`_steps`; none when it does
+# not play), the least time the right hand needs since its last stroke at a stretch
+# (:meth:`Timing.stretch_gap` less TIME_EPS_S; -inf for every piece when it does not
+# play), the same four for the left hand, motion that ends the group (the next row),
+# penalty, first played motion, table cost first -> second played motion (0.0 for
+# one stroke)).
 _Need = dict[str | None, float]
+_Steps = dict[str | None, tuple[tuple[float, float], ...]]
 _Played = tuple[
     int,
     str | None,
     float,
-    _Need,
+    _Steps,
     _Need,
     str | None,
     float,
-    _Need,
+    _Steps,
     _Need,
     int,
     float,
@@ -211,14 +230,21 @@ _Played = tuple[
 ]
 
 
-def _needs(timing: Timing, piece: str | None, *, stretch: bool) -> _Need:
-    """``Timing.gap(prev, piece) - TIME_EPS_S`` (``stretch``: ``stretch_gap``) for every
-    previous piece of a hand (none included): the same floats :func:`transition`
-    compares with, looked up once."""
+def _needs(timing: Timing, piece: str | None) -> _Need:
+    """``Timing.stretch_gap(prev, piece) - TIME_EPS_S`` for every previous piece of a
+    hand (none included): the same floats :func:`transition` compares with, looked up
+    once."""
     if piece is None:
         return dict.fromkeys((None, *HAND_PIECES), -math.inf)
-    gap = timing.stretch_gap if stretch else timing.gap
-    return {prev: gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
+    return {prev: timing.stretch_gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
+
+
+def _all_steps(timing: Timing, piece: str | None) -> _Steps:
+    """:func:`_steps` for every previous piece of a hand (none included); none at all
+    when the hand does not play."""
+    if piece is None:
+        return dict.fromkeys((None, *HAND_PIECES), ())
+    return {prev: _steps(timing, prev, piece) for prev in (None, *HAND_PIECES)}
 
 
 @dataclass(frozen=True, slots=True)
@@ -256,12 +282,12 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     k,
                     r_piece,
                     r_dt,
-                    _needs(timing, r_piece, stretch=False),
-                    _needs(timing, r_piece, stretch=True),
+                    _all_steps(timing, r_piece),
+                    _needs(timing, r_piece),
                     l_piece,
                     l_dt,
-                    _needs(timing, l_piece, stretch=False),
-                    _needs(timing, l_piece, stretch=True),
+                    _all_steps(timing, l_piece),
+                    _needs(timing, l_piece),
                     last,
                     penalty,
                     first,
@@ -348,7 +374,6 @@ def solve(
     least objective, in their order; no effect on a layer that is not larger.
     """
     max_interval = timing.max_gap
-    stretch_pen = timing.stretch_penalty
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
@@ -402,11 +427,11 @@ def solve(
                     k,
                     r_piece,
                     r_dt,
-                    r_need,
+                    r_steps,
                     r_reach,
                     l_piece,
                     l_dt,
-                    l_need,
+                    l_steps,
                     l_reach,
                     last,
                     penalty,
@@ -417,12 +442,15 @@ def solve(
                     r_since, l_since = since_r + r_dt, since_l + l_dt
                     if r_since < r_reach[p_right] or l_since < l_reach[p_left]:
                         continue
-                    if r_since < r_need[p_right]:  # at a stretch (stretch_penalty)
-                        penalty = penalty + stretch_pen
-                        if l_since < l_need[p_left]:
-                            penalty = penalty + stretch_pen
-                    elif l_since < l_need[p_left]:
-                        penalty = penalty + stretch_pen
+                    # at a stretch, at speed (stroke_penalty): the left hand's first
+                    for time, pen in l_steps[p_left]:
+                        if l_since < time:
+                            penalty = penalty + pen
+                            break
+                    for time, pen in r_steps[p_right]:
+                        if r_since < time:
+                            penalty = penalty + pen
+                            break
                     nr, npr = keep_r, keep_pr
                     if r_piece is not None:
                         nr = None if t - (t + r_dt) >= max_interval else t + r_dt

@@ -272,3 +272,36 @@ def test_a_note_known_at_the_last_impact_lets_the_stick_rebound_first(
         assert contact_distance(a, p, p.impact)[0] < 1e-4
         h = (_tips(a, np.array([p.impact + 0.03]))[:, 1] - ride.centre) @ ride.normal
         assert h[0] > 0.005  # off the cymbal 30 ms after the impact
+
+
+def test_a_squeezed_move_goes_at_even_speed() -> None:
+    """A move the plan squeezes ramps up and down over 20 % each and goes at constant
+    speed between: its peak is 1.25x the average (smoothstep's 1.5x made the jumps)."""
+    from virja.motion.drummer_hands import _ramped
+
+    u = np.linspace(0.0, 1.0, 2001)
+    f = _ramped(u)
+    assert f[0] == 0.0 and abs(f[-1] - 1.0) < 1e-12
+    slope = np.diff(f) / np.diff(u)
+    assert slope.min() >= 0.0
+    assert abs(slope.max() - 1.25) < 0.01
+    assert np.abs(np.diff(slope)).max() < 0.01  # the speed has no step
+
+
+def test_a_hand_leaving_the_hihat_for_the_snare_stays_over_its_edge(
+    library: MotionLibrary,
+) -> None:
+    """Left hand side-stick, open hi-hat, side-stick 0.2 s apart (MMA Swing1 at 300 bpm,
+    1.2-1.6 s): leaving the hi-hat for the snare the tip keeps clear of the top cymbal
+    until it is past its edge (it dipped under it at 1.53 s)."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    a.add_planned(replace(drum("snare_left_hand", 1.0, 1.202, velocity=78), note=37))
+    a.add_planned(replace(drum("hihat_left_hand", 1.2, 1.401, velocity=57), note=46))
+    a.add_planned(replace(drum("snare_left_hand", 1.403, 1.603, velocity=71), note=37))
+    ts = np.linspace(1.4, 1.6, 97)
+    hh = GEOMETRY.kit.pieces["hihat"]
+    top = hh.centre + hh.thickness / 2 * hh.normal
+    rel = _tips(a, ts)[:, 0] - top
+    h = rel @ hh.normal
+    radial = np.linalg.norm(rel - h[:, None] * hh.normal, axis=1)
+    assert not ((h < -0.005) & (radial < hh.radius)).any()

@@ -6,6 +6,8 @@ import dataclasses
 import itertools
 import random
 
+import pytest
+
 from virja.plan import drums
 from virja.plan.config import PlanConfig
 from virja.plan.drums import LEFT, RIGHT, HandGroup, Stroke
@@ -229,3 +231,68 @@ def test_feet_and_folded_notes_follow_the_issue(config: PlanConfig) -> None:
     assert kit.notes[38].priority < kit.notes[42].priority == kit.notes[51].priority
     assert kit.notes[51].priority < kit.notes[45].priority < kit.notes[49].priority
     assert kit.notes[49].priority < kit.notes[56].priority  # nobody's percussion last
+
+
+def test_a_move_pays_for_the_speed_it_needs_by_tiers(config: PlanConfig) -> None:
+    """[hand_speed]: distance between the strike points / time since the hand's stroke."""
+    timing = config.timing
+    far = timing.distances[("ride", "snare")]
+    assert 0.6 < far < 0.8
+    pen = [drums.stroke_penalty(timing, "ride", "snare", far / v) for v in (2.0, 3.5, 5, 6.5)]
+    assert pen == [0.0, 4.0, 30.0, 150.0]
+    assert drums.stroke_penalty(timing, "ride", "snare", 0.066) == 320.0  # 10 m/s of tip
+    # a rebound on one piece pays no speed, only the stretch below its min_interval_s
+    assert drums.stroke_penalty(timing, "snare", "snare", 0.05) == 0.0
+    assert drums.stroke_penalty(timing, "snare", "snare", 0.02) == timing.stretch_penalty
+    # a stretch costs at least the stretch's penalty, whatever the speed tier says
+    gap = timing.gap("snare", "tom_high")
+    assert drums.stroke_penalty(timing, "snare", "tom_high", gap - 0.002) >= 150.0
+    # a hand's stroke is remembered as long as a tier can charge it
+    assert timing.max_gap >= max(timing.distances.values()) / 3.0 - 1e-9
+
+
+def test_at_300_bpm_the_hand_with_time_takes_the_snare_not_the_crossing_one(
+    config: PlanConfig,
+) -> None:
+    """MMA Swing1 at 300 bpm: ride with the right, then snare and open hi-hat together
+    66 ms after the ride.  With a flat stretch the right hand crossed 0.5 m from the ride
+    to the snare in 66 ms; now the left hand (on the snare) takes it and the foot the
+    hi-hat, or the left hand the hi-hat; the right hand stays on the ride."""
+    ride, snare = Stroke("ride", 5), Stroke("snare", 6)
+    hh = Stroke("hihat", 3, foot=True)
+    groups = [
+        HandGroup(0.0, (ride, snare)),
+        HandGroup(0.130, (hh, Stroke("ride", 5, dt=0.002))),
+        HandGroup(0.198, (snare, Stroke("hihat", 3, dt=0.001, foot=True))),
+        HandGroup(0.330, (hh, ride)),
+    ]
+    sol = drums.solve(config.costs, config.timing, drums.START, groups)
+    for g, a in zip(groups, sol.assignments, strict=True):
+        for s, h in zip(g.strokes, a, strict=True):
+            if s.piece == "snare":
+                assert h == LEFT
+            if s.piece == "ride":
+                assert h == RIGHT
+    flat = dataclasses.replace(config.timing, speed_tiers=())
+    sol = drums.solve(config.costs, flat, drums.START, groups)
+    assert sol.assignments[2][0] == RIGHT  # what the flat stretch chose: the crossing
+
+
+def test_hand_speed_table_errors() -> None:
+    from virja.errors import ConfigError
+    from virja.plan.config import parse_timing
+    from virja.resources import motions_file
+    from virja import tomlconf
+
+    path = motions_file("timing.toml", None)
+    assert path is not None
+    data = tomlconf.read(path)
+    assert parse_timing(data).speed_tiers[0] == (3.0, 4.0)
+    for bad in (
+        {"speeds_m_s": [3.0, 2.0], "penalties": [1.0, 2.0]},
+        {"speeds_m_s": [3.0], "penalties": [1.0, 2.0]},
+        {"speeds_m_s": [0.0], "penalties": [1.0]},
+        {"speeds_m_s": [3.0], "penalties": [-1.0]},
+    ):
+        with pytest.raises(ConfigError, match="hand_speed"):
+            parse_timing({**data, "hand_speed": bad})

@@ -279,10 +279,10 @@ def test_at_300_bpm_the_hand_with_time_takes_the_snare_not_the_crossing_one(
 
 
 def test_hand_speed_table_errors() -> None:
+    from virja import tomlconf
     from virja.errors import ConfigError
     from virja.plan.config import parse_timing
     from virja.resources import motions_file
-    from virja import tomlconf
 
     path = motions_file("timing.toml", None)
     assert path is not None

@@ -52,10 +52,12 @@ _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
 _MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
-# exponents, see _height_share; the lag 2.5 (was 2): a soft side-stick hand leaving the
-# open hi-hat for the snare dipped its tip under the top cymbal's edge (MMA Swing1 at
-# 300 bpm, 12 such runs in 12 s)
-_RISE_LEAD, _DROP_LAG = 1.5, 2.5
+_RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
+# a move off the hi-hat (the low cymbal beside the snare) keeps its height later still: a
+# soft side-stick hand leaving the open hi-hat for the snare dipped its tip under the top
+# cymbal's edge (MMA Swing1 at 300 bpm, 12 such runs in 12 s); off the high crash and
+# ride the longer lag made the drop's end too fast (jumps of 15-17 cm a frame at 30 fps)
+_MOVE_OFF_HIHAT, _HIHAT_LAG = 5, 2.5
 # a move the plan squeezes (no time to hover first): constant speed between two short
 # ramps of this share each, so the peak speed is 1 / (1 - _RAMP) of the average (1.25;
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
@@ -107,6 +109,7 @@ class _Pose:
     grip: np.ndarray
     rot: np.ndarray
     elbow: np.ndarray
+    piece: str | None = None  # the piece struck in this pose
 
 
 @dataclass
@@ -226,12 +229,14 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
     given its full time (:data:`_MOVE`) a hand going up also rises first, on a
     squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first;
     all start and end at rest."""
+    moving = (profile == _MOVE) | (profile == _MOVE_OFF_HIHAT)
     lead = np.where(
-        profile == _MOVE,
+        moving,
         1.0 - (1.0 - u) ** _RISE_LEAD,
         np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
     )
-    return np.where(rise > 0, lead, u**_DROP_LAG)
+    lag = np.where(profile == _MOVE_OFF_HIHAT, u**_HIHAT_LAG, u**_DROP_LAG)
+    return np.where(rise > 0, lead, lag)
 
 
 def _pose_at(a: np.ndarray, b: np.ndarray, u: float, shape: int) -> np.ndarray:
@@ -350,6 +355,7 @@ class DrummerHands:
             p[_SK.index(f"{side}HandEnd")].copy(),
             r[_SK.index(f"{side}Hand")].copy(),
             p[_SK.index(f"{side}ForeArm")] - self._shoulder[hand],
+            clip.piece,
         )
         self._poses[key] = pose
         if self._ref[hand] is None:  # the arm's reference frames for the IK (the ready pose)
@@ -494,6 +500,7 @@ class DrummerHands:
                 landed.append(base.last)
                 prev_t, prev_lift = base.last[0], base.last[1]
             self._settle(hand, base, pt, pv, pp, lt, lv, lp)
+        prev_piece: str | None = None
         for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
@@ -522,7 +529,9 @@ class DrummerHands:
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
-                _add(pt, pv, pp, t, target, _MOVE)  # time enough: over the cymbals' edges
+                # time enough: over the cymbals' edges
+                off_hihat = prev_piece == "hihat"
+                _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
                 _add(pt, pv, pp, t, target, _SQUEEZED)
             rebound = -math.inf  # when the last stroke's rebound is over
@@ -550,7 +559,7 @@ class DrummerHands:
             _add(pt, pv, pp, away, target, _SMOOTH)
             home = np.concatenate([rest.grip, rest.rot, rest.elbow])
             _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
-            prev_t, prev_lift = t, lift
+            prev_t, prev_lift, prev_piece = t, lift, pose.piece
             landed.append((t, lift, target))
         self._lists[hand] = (pt, pv, pp, lt, lv, lp, landed)
         rows = np.array(pv)

@@ -305,3 +305,40 @@ def test_a_hand_leaving_the_hihat_for_the_snare_stays_over_its_edge(
     h = rel @ hh.normal
     radial = np.linalg.norm(rel - h[:, None] * hh.normal, axis=1)
     assert not ((h < -0.005) & (radial < hh.radius)).any()
+
+
+def test_a_hand_gets_out_of_the_other_hands_way_on_a_cymbal(library: MotionLibrary) -> None:
+    """GMD rock-prog 190 at 6.2 s: the left hand plays the hi-hat, the right comes back to
+    it 0.27 s later.  The left leaves for the ready pose from when that stroke is known
+    (the sticks passed through each other as the right came in under the hovering
+    left); posed live, every frame drawn stays as drawn."""
+    from virja.motion.drummer_report import STICK_RADIUS_M, _segment_distance
+
+    notes = [
+        drum("snare_left_hand", 0.7, 0.9, velocity=80),
+        drum("snare_right_hand", 0.85, 1.03, velocity=120),
+        drum("hihat_left_hand", 0.95, 1.157, velocity=66),
+        drum("hihat_right_hand", 1.2, 1.302, velocity=74),
+        drum("hihat_right_hand", 1.33, 1.43, velocity=58),
+    ]
+    ts = np.arange(0.6, 2.0, 1 / 120)
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    drawn, k = [], 0
+    for t in ts:
+        while k < len(notes) and notes[k].start <= t:
+            a.add_planned(notes[k])
+            k += 1
+        drawn.append(a.local_rotations(float(t)))
+        a.mark_drawn(float(t))
+    again = a.local_rotations_many(ts)
+    np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
+    pos, rot = SKELETON.fk(again, a._roots)
+    stk = sticks(pos[:, 0], rot[:, 0])
+    d = _segment_distance(stk[:, 0, 0], stk[:, 0, 1], stk[:, 1, 0], stk[:, 1, 1])
+    assert d.min() > 2 * STICK_RADIUS_M
+    left_tip = stk[:, 0, 1]
+    at = np.searchsorted(ts, 1.29)
+    hh = GEOMETRY.kit.strike_point("hihat")
+    assert np.linalg.norm(left_tip[at] - hh) > 0.1  # out of the way before the right lands
+    for p in notes:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4

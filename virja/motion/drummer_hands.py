@@ -58,6 +58,13 @@ _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
 # cymbal's edge (MMA Swing1 at 300 bpm, 12 such runs in 12 s); off the high crash and
 # ride the longer lag made the drop's end too fast (jumps of 15-17 cm a frame at 30 fps)
 _MOVE_OFF_HIHAT, _HIHAT_LAG = 5, 2.5
+# a hand hovering over a cymbal that the other hand strikes next (the right hand back on
+# the hi-hat, to the crash the left just played) gets out of its way to the ready pose
+# as soon as that stroke is known, if it has at least _YIELD_MIN_S before it: sticks
+# passed through each other as the hands swapped over a cymbal (GMD rock-prog 190)
+_YIELDING = frozenset({"hihat", "ride", "crash"})
+_YIELD_MIN_S = 0.08
+_YIELD_AFTER_S = 0.05  # after its own impact: the stick leaves the cymbal at once
 # a move the plan squeezes (no time to hover first): constant speed between two short
 # ramps of this share each, so the peak speed is 1 / (1 - _RAMP) of the average (1.25;
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
@@ -147,7 +154,7 @@ class _Base:
     lt: list[float]
     lv: list[float]
     lp: list[Any]
-    last: tuple[float, float, np.ndarray] | None
+    last: tuple[float, float, np.ndarray, str | None] | None
 
 
 def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
@@ -421,20 +428,24 @@ class DrummerHands:
             ids[ids.index(key)] = None
 
     def _change(self, hand: str, drawn: float, apply: Callable[[], None]) -> None:
-        """``apply`` a change of ``hand``'s strokes without changing its track at or
-        before ``drawn``: if the rebuilt track differs there, the old one is frozen
-        up to ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
-        old = self.keys(hand) if drawn > -math.inf else None
-        old_lists = self._lists[hand]
+        """``apply`` a change of ``hand``'s strokes without changing either hand's track
+        at or before ``drawn`` (the other hand may get out of a stroke's way,
+        :meth:`_yield`): if a rebuilt track differs there, the old one is frozen up to
+        ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
+        live = drawn > -math.inf
+        olds = {h: (self.keys(h) if live else None, self._lists[h]) for h in HANDS}
         apply()
-        self._keys[hand] = None
-        if old is None or old_lists is None:
-            return
-        new = self.keys(hand)
-        if new is not None and _same_until(old, new, drawn):
-            return
-        self._freeze(hand, drawn, old_lists)
-        self._keys[hand] = None
+        for h in HANDS:
+            self._keys[h] = None
+        for h in HANDS:
+            old, old_lists = olds[h]
+            if old is None or old_lists is None:
+                continue
+            new = self.keys(h)
+            if new is not None and _same_until(old, new, drawn):
+                continue
+            self._freeze(h, drawn, old_lists)
+            self._keys[h] = None
 
     def _freeze(self, hand: str, t: float, lists: tuple[Any, ...]) -> None:
         """Freeze ``hand``'s track (the build that gave ``lists``) up to ``t``."""
@@ -474,6 +485,30 @@ class DrummerHands:
             by_vel = max(by_vel, s.rim_min_m)
         return float(min(by_vel, s.lift_per_s * gap))
 
+    def _yield(
+        self, hand: str, t: float, piece: str | None, next_t: float
+    ) -> tuple[float, float] | None:
+        """(when ``hand`` starts to get out of the way, the other hand's impact) when the
+        other hand strikes the cymbal ``hand`` struck at ``t`` before ``hand`` strikes
+        again at ``next_t``; from when that stroke is known, after the rebound."""
+        if piece not in _YIELDING:
+            return None
+        other = HANDS[1 - HANDS.index(hand)]
+        times = self._times[other]
+        for j in range(bisect.bisect_right(times, t), len(times)):
+            t_o = times[j]
+            if t_o >= next_t:
+                return None
+            start_o, pose_o, _v, _a = self._strokes[other][j]
+            if pose_o.piece != piece:
+                continue
+            cut = max(start_o, t + _YIELD_AFTER_S)
+            if cut >= t + 0.5 * self.settings.rest_after_s:
+                return None  # going to rest anyway
+            if t_o - cut >= _YIELD_MIN_S:  # else out of the way of its next stroke there
+                return cut, t_o
+        return None
+
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
         if nothing follows), cut where the next stroke becomes known (its start, never
@@ -489,19 +524,40 @@ class DrummerHands:
         lp: list[Any] = []
         prev_t: float | None = None
         prev_lift = 0.0
-        landed: list[tuple[float, float, np.ndarray]] = []  # (impact, lift, pose row)
+        # (impact, lift, pose row, piece)
+        landed: list[tuple[float, float, np.ndarray, str | None]] = []
         base = self._base[hand]
         floor = -math.inf
+        prev_piece: str | None = None
+        times = self._times[hand]
+        home = np.concatenate([rest.grip, rest.rot, rest.elbow])
+
+        def get_out_of_the_way(t: float, piece: str | None, nxt: float) -> None:
+            """After the stroke at ``t`` on ``piece``, to the ready pose if the other
+            hand strikes that cymbal before ``nxt`` (:meth:`_yield`)."""
+            yielding = self._yield(hand, t, piece, nxt)
+            if yielding is None or max(yielding[0], floor) >= yielding[1]:
+                return
+            at, t_o = max(yielding[0], floor), yielding[1]  # never before what is frozen
+            _cut(pt, pv, pp, at, _pose_at)
+            _cut(lt, lv, lp, at, _lift_at)
+            clear = at + min(s.rest_move_s, t_o - at)
+            _add(pt, pv, pp, clear, home, _SQUEEZED)
+            _add(lt, lv, lp, clear, 0.0, _SMOOTH)
+
         if base is not None:  # frozen up to a frame drawn: build on from there
             floor = base.t
             pt, pv, pp = list(base.pt), list(base.pv), list(base.pp)
             lt, lv, lp = list(base.lt), list(base.lv), list(base.lp)
+            self._settle(hand, base, pt, pv, pp, lt, lv, lp)
             if base.last is not None:
                 landed.append(base.last)
-                prev_t, prev_lift = base.last[0], base.last[1]
-            self._settle(hand, base, pt, pv, pp, lt, lv, lp)
-        prev_piece: str | None = None
-        for t, (start, pose, vel, art) in zip(self._times[hand], self._strokes[hand], strict=True):
+                prev_t, prev_lift, prev_piece = base.last[0], base.last[1], base.last[3]
+                nxt = next((u for u in times if u > floor), math.inf)
+                get_out_of_the_way(prev_t, prev_piece, nxt)
+        for i, (t, (start, pose, vel, art)) in enumerate(
+            zip(times, self._strokes[hand], strict=True)
+        ):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
             target = np.concatenate([pose.grip, pose.rot, pose.elbow])
@@ -559,8 +615,10 @@ class DrummerHands:
             _add(pt, pv, pp, away, target, _SMOOTH)
             home = np.concatenate([rest.grip, rest.rot, rest.elbow])
             _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
+            nxt = next((u for u in times[i + 1 :] if u - t >= 1e-6), math.inf)
+            get_out_of_the_way(t, pose.piece, nxt)
             prev_t, prev_lift, prev_piece = t, lift, pose.piece
-            landed.append((t, lift, target))
+            landed.append((t, lift, target, pose.piece))
         self._lists[hand] = (pt, pv, pp, lt, lv, lp, landed)
         rows = np.array(pv)
         seg = [_segment(*k) for k in zip(pp, pt, pv, strict=True)]

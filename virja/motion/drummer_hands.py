@@ -505,8 +505,8 @@ class DrummerHands:
             cut = max(start_o, t + _YIELD_AFTER_S)
             if cut >= t + 0.5 * self.settings.rest_after_s:
                 return None  # going to rest anyway
-            if t_o - cut >= _YIELD_MIN_S:  # else out of the way of its next stroke there
-                return cut, t_o
+            # no time to get out of the way: stay rather than cross the incoming stick
+            return (cut, t_o) if t_o - cut >= _YIELD_MIN_S else None
         return None
 
     def _build(self, hand: str) -> _Keys:

@@ -236,9 +236,9 @@ def test_feet_and_folded_notes_follow_the_issue(config: PlanConfig) -> None:
 def test_a_move_pays_for_the_speed_it_needs_by_tiers(config: PlanConfig) -> None:
     """[hand_speed]: distance between the strike points / time since the hand's stroke."""
     timing = config.timing
-    far = timing.distances[("ride", "snare")]
-    assert 0.6 < far < 0.8
-    pen = [drums.stroke_penalty(timing, "ride", "snare", far / v) for v in (2.0, 3.5, 5, 6.5)]
+    far = timing.distances[("hihat", "snare")]
+    assert 0.35 < far < 0.45
+    pen = [drums.stroke_penalty(timing, "hihat", "snare", far / v) for v in (2.0, 3.5, 5, 6.5)]
     assert pen == [0.0, 4.0, 30.0, 150.0]
     assert drums.stroke_penalty(timing, "ride", "snare", 0.066) == 320.0  # 10 m/s of tip
     # a rebound on one piece pays no speed, only the stretch below its min_interval_s
@@ -247,8 +247,10 @@ def test_a_move_pays_for_the_speed_it_needs_by_tiers(config: PlanConfig) -> None
     # a stretch costs at least the stretch's penalty, whatever the speed tier says
     gap = timing.gap("snare", "tom_high")
     assert drums.stroke_penalty(timing, "snare", "tom_high", gap - 0.002) >= 150.0
-    # a hand's stroke is remembered as long as a tier can charge it
-    assert timing.max_gap >= max(timing.distances.values()) / 3.0 - 1e-9
+    # a hand's stroke is remembered as long as a tier can charge it: memory_s
+    assert timing.max_gap == timing.speed_memory_s == 0.2
+    assert drums.stroke_penalty(timing, "ride", "crash", 0.21) == 0.0  # 4.1 m/s, forgotten
+    assert drums.stroke_penalty(timing, "ride", "crash", 0.195) == 4.0  # 4.4 m/s
 
 
 def test_at_300_bpm_the_hand_with_time_takes_the_snare_not_the_crossing_one(
@@ -293,6 +295,7 @@ def test_hand_speed_table_errors() -> None:
         {"speeds_m_s": [3.0], "penalties": [1.0, 2.0]},
         {"speeds_m_s": [0.0], "penalties": [1.0]},
         {"speeds_m_s": [3.0], "penalties": [-1.0]},
+        {"speeds_m_s": [3.0], "penalties": [1.0], "memory_s": 0.0},
     ):
         with pytest.raises(ConfigError, match="hand_speed"):
             parse_timing({**data, "hand_speed": bad})

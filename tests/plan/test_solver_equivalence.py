@@ -11,6 +11,7 @@ per-stroke cost, state and total must be identical, ties included.
 from __future__ import annotations
 
 import dataclasses
+import math
 import random
 from collections.abc import Sequence
 
@@ -154,7 +155,10 @@ def _random_case(
     if rng.random() < 0.5:  # the hand's speed tiers: none, the shipped ones, odd ones
         tiers = rng.choice([(), config.timing.speed_tiers, ((2.0, 0.5), (5.0, 3.0), (9.0, 0.1))])
         timing = dataclasses.replace(
-            timing, speed_tiers=tiers, distances=rng.choice([{}, config.timing.distances])
+            timing,
+            speed_tiers=tiers,
+            distances=rng.choice([{}, config.timing.distances]),
+            speed_memory_s=rng.choice([math.inf, 0.2, 0.05]),
         )
     state = drums.START
     if rng.random() < 0.3:  # a fixed state left by an earlier plan

@@ -203,6 +203,7 @@ class Timing:
     # speed the move needs (``distances[(prev, piece)]`` / time since the last stroke)
     speed_tiers: tuple[tuple[float, float], ...] = ()
     distances: dict[tuple[str, str], float] = field(default_factory=dict)
+    speed_memory_s: float = math.inf  # a stroke older than this pays no speed tier
 
     def get(self, kind: str) -> MotionTiming:
         try:
@@ -239,7 +240,10 @@ class Timing:
         steps = [(self.gap(prev, piece), self.stretch_penalty)] if self.stretch_penalty else []
         if prev is not None and prev != piece:
             dist = self.distances.get((prev, piece), 0.0)
-            steps += [(dist / speed, pen) for speed, pen in self.speed_tiers if pen and dist]
+            mem = self.speed_memory_s
+            steps += [
+                (min(dist / speed, mem), pen) for speed, pen in self.speed_tiers if pen and dist
+            ]
         return tuple(sorted(steps, key=lambda s: (-s[1], -s[0])))
 
     @property
@@ -250,7 +254,7 @@ class Timing:
         return max(
             max((mt.min_interval_s for mt in self.kinds.values()), default=0.0),
             max(self.moves.values(), default=0.0),
-            max(self.distances.values(), default=0.0) / slowest,
+            min(max(self.distances.values(), default=0.0) / slowest, self.speed_memory_s),
         )
 
 
@@ -331,6 +335,7 @@ class HandStretchTable(Schema):
 class HandSpeedTable(Schema):
     speeds_m_s: list[float]
     penalties: list[float]
+    memory_s: float = math.inf
 
 
 MotionTimingTable = schema_of(MotionTiming)
@@ -481,14 +486,17 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
             or any(v <= 0 for v in speeds)
             or any(p < 0 for p in pens)
             or speeds != sorted(set(speeds))
+            or not sp.memory_s > 0
         ):
             raise ConfigError(
-                f"{where}: hand_speed needs as many penalties (>= 0) as speeds_m_s (> 0, rising)"
+                f"{where}: hand_speed needs as many penalties (>= 0) as speeds_m_s "
+                "(> 0, rising) and memory_s > 0"
             )
         timing = dataclasses.replace(
             timing,
             speed_tiers=tuple(zip(speeds, pens, strict=True)),
             distances=hand_distances(),
+            speed_memory_s=sp.memory_s,
         )
     return timing
 

@@ -132,11 +132,11 @@ def transition(
     prev, prev_t, t_right, t_left, p_right, p_left = state
     t = group.time
     stretch = 0.0
-    for stroke, hand in sorted(
+    for stroke, by in sorted(
         ((s, h) for s, h in zip(group.strokes, assign, strict=True) if h is not None),
         key=lambda sh: sh[1] != LEFT,
     ):  # left hand first, as the solver adds them
-        last, lp = (t_right, p_right) if hand == RIGHT else (t_left, p_left)
+        last, lp = (t_right, p_right) if by == RIGHT else (t_left, p_left)
         if last is None:
             continue
         since = t + stroke.dt - last
@@ -212,7 +212,8 @@ class _Option:
 # penalty, first played motion, table cost first -> second played motion (0.0 for
 # one stroke)).
 _Need = dict[str | None, float]
-_Steps = dict[str | None, tuple[tuple[float, float], ...]]
+# per previous piece: (the largest time of the steps, -inf for none; the steps)
+_Steps = dict[str | None, tuple[float, tuple[tuple[float, float], ...]]]
 _Played = tuple[
     int,
     str | None,
@@ -243,8 +244,12 @@ def _all_steps(timing: Timing, piece: str | None) -> _Steps:
     """:func:`_steps` for every previous piece of a hand (none included); none at all
     when the hand does not play."""
     if piece is None:
-        return dict.fromkeys((None, *HAND_PIECES), ())
-    return {prev: _steps(timing, prev, piece) for prev in (None, *HAND_PIECES)}
+        return dict.fromkeys((None, *HAND_PIECES), (-math.inf, ()))
+    out: _Steps = {}
+    for prev in (None, *HAND_PIECES):
+        steps = _steps(timing, prev, piece)
+        out[prev] = (max((time for time, _pen in steps), default=-math.inf), steps)
+    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -443,14 +448,18 @@ def solve(
                     if r_since < r_reach[p_right] or l_since < l_reach[p_left]:
                         continue
                     # at a stretch, at speed (stroke_penalty): the left hand's first
-                    for time, pen in l_steps[p_left]:
-                        if l_since < time:
-                            penalty = penalty + pen
-                            break
-                    for time, pen in r_steps[p_right]:
-                        if r_since < time:
-                            penalty = penalty + pen
-                            break
+                    limit, steps = l_steps[p_left]
+                    if l_since < limit:
+                        for time, pen in steps:
+                            if l_since < time:
+                                penalty = penalty + pen
+                                break
+                    limit, steps = r_steps[p_right]
+                    if r_since < limit:
+                        for time, pen in steps:
+                            if r_since < time:
+                                penalty = penalty + pen
+                                break
                     nr, npr = keep_r, keep_pr
                     if r_piece is not None:
                         nr = None if t - (t + r_dt) >= max_interval else t + r_dt

@@ -248,9 +248,9 @@ def test_a_move_pays_for_the_speed_it_needs_by_tiers(config: PlanConfig) -> None
     gap = timing.gap("snare", "tom_high")
     assert drums.stroke_penalty(timing, "snare", "tom_high", gap - 0.002) >= 150.0
     # a hand's stroke is remembered as long as a tier can charge it: memory_s
-    assert timing.max_gap == timing.speed_memory_s == 0.2
-    assert drums.stroke_penalty(timing, "ride", "crash", 0.21) == 0.0  # 4.1 m/s, forgotten
-    assert drums.stroke_penalty(timing, "ride", "crash", 0.195) == 4.0  # 4.4 m/s
+    assert timing.max_gap == timing.speed_memory_s == 0.25
+    assert drums.stroke_penalty(timing, "ride", "crash", 0.26) == 0.0  # 3.3 m/s, forgotten
+    assert drums.stroke_penalty(timing, "ride", "crash", 0.24) == 4.0  # 3.6 m/s
 
 
 def test_at_300_bpm_the_hand_with_time_takes_the_snare_not_the_crossing_one(

@@ -12,7 +12,10 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   struck and waits there; the hand leaves for the next piece only when it must
   (``distance / move_speed`` before the backswing key, or at once when the
   time is short); after ``rest_after_s`` without a stroke it goes to the
-  relaxed ready pose and comes back in time for the next.
+  relaxed ready pose and comes back in time for the next.  A move the plan
+  leaves less time than that goes at even speed between short ramps
+  (``_SQUEEZED``); a hand over a cymbal that the other hand strikes next gets
+  out of its way to the ready pose (:meth:`DrummerHands._yield`).
 - **lift**: velocity sets the stick tip's height above the surface (not a
   scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity
   (to the power ``lift_curve``; a side-stick at most ``side_stick_m``, a rim

@@ -48,6 +48,7 @@ import numpy as np
 from virja.motion import quat
 from virja.motion.clip import Clip
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
+from virja.vocab import CYMBAL_PIECES
 
 _SK = SKELETON
 HANDS = ("left_hand", "right_hand")
@@ -65,7 +66,7 @@ _MOVE_OFF_HIHAT, _HIHAT_LAG = 5, 2.5
 # the hi-hat, to the crash the left just played) gets out of its way to the ready pose
 # as soon as that stroke is known, if it has at least _YIELD_MIN_S before it: sticks
 # passed through each other as the hands swapped over a cymbal (GMD rock-prog 190)
-_YIELDING = frozenset({"hihat", "ride", "crash"})
+_YIELDING = frozenset(CYMBAL_PIECES)
 _YIELD_MIN_S = 0.08
 _YIELD_AFTER_S = 0.05  # after its own impact: the stick leaves the cymbal at once
 # a move the plan squeezes (no time to hover first): constant speed between two short

@@ -16,13 +16,25 @@ import random
 from collections.abc import Sequence
 
 from virja.plan import bass, drums
-from virja.plan.config import DrumCosts, MotionTiming, PlanConfig, Timing
+from virja.plan.bounds import keep_best
+from virja.plan.config import (
+    BassSetup,
+    DrumCosts,
+    Fingering,
+    MotionTiming,
+    PlanConfig,
+    Timing,
+)
 from virja.plan.drums import RIGHT, Assignment, HandGroup, HandSolution, HandState, Stroke
 from virja.vocab import HAND_PIECES
 
 
 def _reference_drums(
-    costs: DrumCosts, timing: Timing, state: HandState, groups: Sequence[HandGroup]
+    costs: DrumCosts,
+    timing: Timing,
+    state: HandState,
+    groups: Sequence[HandGroup],
+    beam: int | None = None,
 ) -> HandSolution:
     """The plain DP over hand states (the solver as it was before it was sped up; hand
     states carry each hand's last piece, strokes their offset in the group)."""
@@ -87,6 +99,11 @@ def _reference_drums(
                 if old is None or total < old:
                     nxt[new] = total
                     back[new] = (st, k)
+        if beam is not None and len(nxt) > beam:  # the beam: the least, in their order
+            kept = keep_best(list(nxt.values()), beam)
+            assert kept is not None
+            states_in_order = list(nxt)
+            nxt = {states_in_order[i]: nxt[states_in_order[i]] for i in kept}
         best = nxt
         backs.append(back)
     end = min(best, key=lambda s: best[s])
@@ -199,6 +216,20 @@ def test_drum_solver_equals_the_plain_dp_on_random_input(config: PlanConfig) -> 
         )
 
 
+def test_drum_solver_with_a_beam_equals_the_plain_dp_with_one(config: PlanConfig) -> None:
+    """A beam that cuts (layers of more states than it keeps, ties among them) keeps the
+    same states in the same order, so the result is the plain DP's with the same cut."""
+    rng = random.Random(99)
+    cut = 0
+    for _ in range(300):
+        costs, timing, state, groups = _random_case(rng, config)
+        beam = rng.choice([1, 2, 3, 5, 8])
+        got = drums.solve(costs, timing, state, groups, beam=beam)
+        assert got == _reference_drums(costs, timing, state, groups, beam)
+        cut += got != drums.solve(costs, timing, state, groups)
+    assert cut > 10  # the beam did cut, and changed results, in many cases
+
+
 def test_drum_solver_results_do_not_depend_on_earlier_calls(config: PlanConfig) -> None:
     """Compiled options are cached per configuration: another config in between
     (same stroke signatures, other tables) must not leak into the next result."""
@@ -210,17 +241,21 @@ def test_drum_solver_results_do_not_depend_on_earlier_calls(config: PlanConfig) 
 
 
 def _reference_bass(
-    state: bass.BassState, groups: Sequence[Sequence[bass.BassOption]]
+    state: bass.BassState,
+    groups: Sequence[Sequence[bass.BassOption]],
+    fingering: Fingering = bass.DEFAULT_FINGERING,
+    gaps: Sequence[float] | None = None,
 ) -> bass.BassSolution:
     """The plain Viterbi with :func:`virja.plan.bass.transitions` per candidate."""
     best: dict[bass.BassState, float] = {state: 0.0}
     backs = []
-    for options in groups:
+    for gi, options in enumerate(groups):
+        gap = math.inf if gaps is None else gaps[gi]
         nxt: dict[bass.BassState, float] = {}
         back: dict[bass.BassState, tuple[bass.BassState, int, float]] = {}
         for prev, acc in best.items():
             for k, opt in enumerate(options):
-                for c, new in bass.transitions(prev, opt):
+                for c, new in bass.transitions(prev, opt, fingering, gap):
                     if (old := nxt.get(new)) is None or acc + c < old:
                         nxt[new] = acc + c
                         back[new] = (prev, k, c)
@@ -240,19 +275,46 @@ def _reference_bass(
     )
 
 
+def _random_chords(rng: random.Random, setup: BassSetup) -> list[list[int]]:
+    """Up to 12 groups of 1-3 distinct in-range pitches, each high to low."""
+    return [
+        sorted(
+            {bass.fold_into_range(setup, rng.randint(20, 80)) for _ in range(rng.randint(1, 3))},
+            reverse=True,
+        )
+        for _ in range(rng.randint(0, 12))
+    ]
+
+
 def test_bass_solver_equals_the_plain_viterbi_on_random_input(config: PlanConfig) -> None:
     rng = random.Random(5)
     setup = config.bass
     for _ in range(300):
-        groups = []
-        for _ in range(rng.randint(0, 12)):
-            pitches = sorted(
-                {
-                    bass.fold_into_range(setup, rng.randint(20, 80))
-                    for _ in range(rng.randint(1, 3))
-                },
-                reverse=True,
-            )
-            groups.append(bass.group_options(setup, pitches)[1])
+        groups = [bass.group_options(setup, pitches)[1] for pitches in _random_chords(rng, setup)]
         state = rng.choice([None, (0, 3, 2), (3, 12, 10), (1, 1, 1)])
         assert bass.solve(state, groups) == _reference_bass(state, groups)
+
+
+def test_bass_solver_equals_the_plain_viterbi_with_fingerings_gaps_and_memoised_options(
+    config: PlanConfig,
+) -> None:
+    """As the chain calls it: options from :func:`chord_options` (tuples, memoised per
+    fingering), gaps that rush shifts, and fingerings with fractional costs, one after
+    another (a memo kept for one fingering must not answer for another)."""
+    rng = random.Random(11)
+    setup = config.bass
+    fingerings = [
+        bass.DEFAULT_FINGERING,
+        Fingering(shift_cost=0.3, shift_cost_per_fret=0.7, rushed_shift_cost=1.1),
+        Fingering(span_frets=1, thumb_span_frets=4, position_cost_per_fret=0.15),
+    ]
+    for _ in range(300):
+        fingering = rng.choice(fingerings)
+        groups = [
+            bass.chord_options(setup, tuple(pitches))[1] for pitches in _random_chords(rng, setup)
+        ]
+        gaps = [rng.choice([math.inf, 0.0, 0.03, 0.07, 0.2, 1.0]) for _ in groups]
+        state = rng.choice([None, (0, 3, 2), (3, 12, 10), (1, 1, 1)])
+        assert bass.solve(state, groups, fingering, gaps) == _reference_bass(
+            state, groups, fingering, gaps
+        )

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from virja.plan.types import JSON_KEYS, LOG_KEYS, PlannedNote
-from virja.vocab import DrumStroke
+from virja.vocab import BassPluck, DrumStroke
 
 P = PlannedNote(
     time=1.0,
@@ -80,3 +82,21 @@ def test_from_json_rejects_an_unknown_key() -> None:
     data = {**P.to_json(), "origin": 3.0}
     with pytest.raises(ValueError, match="unexpected \\['origin'\\]"):
         PlannedNote.from_json(data)
+
+
+def test_planned_note_of_is_the_same_note_as_the_constructor() -> None:
+    """The planner's fast constructor makes an equal note: same fields in the same
+    order, equal, same hash and repr, the same JSON; still frozen."""
+    for motion, piece, string, fret in (
+        (DrumStroke("snare", "left_hand"), "snare", None, None),
+        (BassPluck("A", 3, 1), None, "A", 3),
+    ):
+        args = (1.25, "drums", 9, 38, 100, "left_hand", piece, string, fret, motion, 1.1, 1.25)
+        made = PlannedNote(*args, 0.5, False)  # type: ignore[arg-type]
+        fast = PlannedNote.of(*args, 0.5, False)  # type: ignore[arg-type]
+        assert fast == made and hash(fast) == hash(made) and repr(fast) == repr(made)
+        assert list(vars(fast)) == [f.name for f in dataclasses.fields(PlannedNote)]
+        assert fast.to_json(1.0) == made.to_json(1.0)
+        assert fast != PlannedNote.of(*args, 0.5, True)  # type: ignore[arg-type]
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            fast.cost = 1.0  # type: ignore[misc]

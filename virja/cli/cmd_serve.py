@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import gc
 import signal
 import sys
 import time
@@ -369,6 +370,12 @@ async def serve(args: argparse.Namespace) -> int:
             perf.plan_log.close()
         raise
     plan_log = perf.plan_log
+    # Start-up is over (modules, tables, the motion library, the planner): those
+    # objects live as long as the daemon, so they leave the collector's generations.
+    # A full collection walking them took about 30 ms (31,000 objects; docs/performance.md),
+    # a pause in the middle of a note's planning or a frame; after this it walks only
+    # what was made since.  (A frozen object is never collected: only start-up's are.)
+    gc.freeze()
     print(
         f"virja serve: listening on {bound[0]}:{bound[1]}"
         + (f", group {args.group}" if args.group else ""),

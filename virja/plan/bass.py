@@ -53,8 +53,14 @@ _MAX_POSITION = 36
 
 def motion_key(string: str, fret: int, hand: BassState) -> BassPluck:
     """The basic motion: ``string`` plucked at ``fret``, with the left hand's position
-    once it has one (an open string keeps the hand where it was)."""
-    return BassPluck(as_bass_string(string), fret, None if hand is None else hand[2])
+    once it has one (an open string keeps the hand where it was).  Made once per
+    motion (a pluck is frozen: shared by every note it plays)."""
+    return _pluck(string, fret, None if hand is None else hand[2])
+
+
+@functools.lru_cache(maxsize=4096)
+def _pluck(string: str, fret: int, position: int | None) -> BassPluck:
+    return BassPluck(as_bass_string(string), fret, position)
 
 
 def fold_into_range(setup: BassSetup, note: int) -> int:
@@ -204,6 +210,75 @@ class BassSolution:
     total: float
 
 
+# One option of a group, worked out once (:func:`_prepared`): its anchor's string and
+# fret (-1, -1: every note open), its melody string, stopped frets, and per hand position
+# the position, the state it leads to and its position cost.
+_Prepared = tuple[int, int, int, int, int, list[tuple[int, HandState, float]]]
+
+
+def _prepare(fingering: Fingering, option: BassOption) -> _Prepared:
+    a = anchor(option)
+    if a is None:
+        return (-1, -1, option[0][0], 0, 0, [])
+    low, high = _stops(option) or (a[1], a[1])
+    per = fingering.position_cost_per_fret
+    hs = [(h, (a[0], a[1], h), per * (h - 1)) for h in hand_positions(fingering, low, high)]
+    return (a[0], a[1], option[0][0], low, high, hs)
+
+
+@dataclass(frozen=True, slots=True)
+class _Tables:
+    """What :func:`solve` works out from the fingering alone, by index (the same floats
+    as the calls): ``span(h)``, ``shift_time(d)`` and the position cost of ``h``, for
+    positions and shifts up to the frets of any fingerboard (36); and per group's
+    options their :func:`_prepare`, memoised (at most _PREPARED_LIMIT groups)."""
+
+    spans: list[int]
+    shift_times: list[float]
+    position_costs: list[float]
+    prepared: dict[Sequence[BassOption], list[_Prepared]]
+
+
+_PREPARED_LIMIT = 4096  # distinct groups' options (chord_options memoises as many)
+# kept across calls for the last fingering used, matched by identity (as
+# virja.plan.drums does for its compiled options; a fingering is frozen); reading the
+# global once makes it safe across threads
+_tables_cache: tuple[Fingering, _Tables] | None = None
+
+
+def _tables(fingering: Fingering) -> _Tables:
+    global _tables_cache
+    entry = _tables_cache
+    if entry is None or entry[0] is not fingering:
+        top = _MAX_POSITION + 1
+        per = fingering.position_cost_per_fret
+        tables = _Tables(
+            [fingering.span(h) for h in range(top)],
+            [fingering.shift_time(d) for d in range(top)],
+            [per * (h - 1) for h in range(top)],
+            {},
+        )
+        entry = _tables_cache = (fingering, tables)
+    return entry[1]
+
+
+def _prepared(
+    tables: _Tables, fingering: Fingering, options: Sequence[BassOption]
+) -> list[_Prepared]:
+    """:func:`_prepare` of each of a group's options, in order (shared: not changed).
+    Hashable options (the tuples of :func:`chord_options`) are memoised; others are
+    worked out each time."""
+    try:
+        found = tables.prepared.get(options)
+    except TypeError:  # a list, or options holding lists: not hashable
+        return [_prepare(fingering, opt) for opt in options]
+    if found is None:
+        if len(tables.prepared) >= _PREPARED_LIMIT:
+            tables.prepared.clear()
+        found = tables.prepared[options] = [_prepare(fingering, opt) for opt in options]
+    return found
+
+
 def solve(
     state: BassState,
     groups: Sequence[Sequence[BassOption]],
@@ -218,60 +293,58 @@ def solve(
     """
     best: dict[BassState, float] = {state: 0.0}
     backs: list[dict[BassState, tuple[BassState, int, float]]] = []
-    per = fingering.position_cost_per_fret
     shift_cost = fingering.shift_cost
     shift_per_fret = fingering.shift_cost_per_fret
     rushed = fingering.rushed_shift_cost
-    # span(h0) and shift_time(d) looked up by index (the same floats as the calls);
-    # positions and shifts never exceed the frets of any fingerboard (36)
-    top = _MAX_POSITION + 1
-    spans = [fingering.span(h) for h in range(top)]
-    shift_times = [fingering.shift_time(d) for d in range(top)]
+    tables = _tables(fingering)
+    spans, shift_times, position_costs = tables.spans, tables.shift_times, tables.position_costs
     for gi, options in enumerate(groups):
         gap = math.inf if gaps is None else gaps[gi]
-        # :func:`transitions` inlined, with what does not depend on the previous state
-        # worked out once per group (same arithmetic, same order, same results)
-        # per option: its anchor, melody string, stopped frets, and per hand position
-        # the position, the state it leads to and its position cost
-        prepared: list[
-            tuple[Position | None, int, int, int, list[tuple[int, HandState, float]]]
-        ] = []
-        for opt in options:
-            a = anchor(opt)
-            if a is None:
-                prepared.append((a, opt[0][0], 0, 0, []))
-                continue
-            low, high = _stops(opt) or (a[1], a[1])
-            hs = [(h, (a[0], a[1], h), per * (h - 1)) for h in hand_positions(fingering, low, high)]
-            prepared.append((a, opt[0][0], low, high, hs))
+        prepared = _prepared(tables, fingering, options)
         nxt: dict[BassState, float] = {}
         back: dict[BassState, tuple[BassState, int, float]] = {}
+        get = nxt.get
         for prev, acc in best.items():
-            for k, (a, melody, low, high, hs) in enumerate(prepared):
-                moves: list[tuple[float, BassState]]
-                if a is None:
-                    moves = [(0.0 if prev is None else float(abs(melody - prev[0])), prev)]
-                elif prev is None:
-                    moves = [(ph, state) for _h, state, ph in hs]
-                else:
-                    s0, f0, h0 = prev
-                    base = float(abs(a[1] - f0) + abs(a[0] - s0))
-                    if h0 <= low and high <= h0 + spans[h0]:
-                        moves = [(base + per * (h0 - 1), (a[0], a[1], h0))]
+            if prev is None:
+                for k, (a0, _a1, _melody, _low, _high, hs) in enumerate(prepared):
+                    if a0 < 0:  # every note open: the hand stays where it is (nowhere)
+                        moves: list[tuple[int, HandState, float]] = [(0, None, 0.0)]  # type: ignore[list-item]
                     else:
-                        moves = []
-                        for h, state, ph in hs:
-                            d = abs(h - h0)
-                            c = base + shift_cost + shift_per_fret * d + ph
-                            if gap < shift_times[d]:
-                                c += rushed
-                            moves.append((c, state))
-                for c, new in moves:
-                    total = acc + c
-                    old = nxt.get(new)
-                    if old is None or total < old:
-                        nxt[new] = total
-                        back[new] = (prev, k, c)
+                        moves = hs
+                    for _h, reached, c in moves:
+                        total = acc + c
+                        old = get(reached)
+                        if old is None or total < old:
+                            nxt[reached] = total
+                            back[reached] = (prev, k, c)
+                continue
+            s0, f0, h0 = prev
+            in_reach = h0 + spans[h0]  # the highest fret the hand covers without a shift
+            for k, (a0, a1, melody, low, high, hs) in enumerate(prepared):
+                if a0 < 0:  # every note open: the hand stays where it is
+                    c = float(abs(melody - s0))
+                    new: BassState = prev
+                elif h0 <= low and high <= in_reach:
+                    c = float(abs(a1 - f0) + abs(a0 - s0)) + position_costs[h0]
+                    new = (a0, a1, h0)
+                else:
+                    base = float(abs(a1 - f0) + abs(a0 - s0))
+                    for h, state_h, ph in hs:
+                        d = abs(h - h0)
+                        c = base + shift_cost + shift_per_fret * d + ph
+                        if gap < shift_times[d]:
+                            c += rushed
+                        total = acc + c
+                        old = get(state_h)
+                        if old is None or total < old:
+                            nxt[state_h] = total
+                            back[state_h] = (prev, k, c)
+                    continue
+                total = acc + c
+                old = get(new)
+                if old is None or total < old:
+                    nxt[new] = total
+                    back[new] = (prev, k, c)
         best = nxt
         backs.append(back)
     end = min(best, key=lambda s: best[s])

@@ -289,21 +289,21 @@ class Chain(AnyChain, Generic[R]):
     ) -> PlannedNote:
         """``rec`` planned and fixed: to the outbox and this chain's history."""
         n = rec.note
-        p = PlannedNote(
-            time=n.time_s,
-            performer=rec.performer,
-            channel=n.channel,
-            note=rec.played,
-            velocity=n.velocity,
-            limb=limb,
-            piece=piece,
-            string=string,
-            fret=fret,
-            motion=motion,
-            start=rec.start,
-            impact=rec.impact,
-            cost=cost,
-            late=rec.late,
+        p = PlannedNote.of(
+            n.time_s,
+            rec.performer,
+            n.channel,
+            rec.played,
+            n.velocity,
+            limb,
+            piece,
+            string,
+            fret,
+            motion,
+            rec.start,
+            rec.impact,
+            cost,
+            rec.late,
         )
         self.ctx.ledger.outbox.append(p)
         self.fixed.append((n.time_s, p))

@@ -44,6 +44,15 @@ class BassChain(Chain[Held]):
         return pitches[:kept], options
 
     def fix_groups(self, groups: list[list[Held]], n_groups: int) -> None:
+        prepared: dict[int, tuple[list[int], tuple[bass_mod.BassOption, ...]]] = {}
+
+        def prepare(gi: int) -> tuple[list[int], tuple[bass_mod.BassOption, ...]]:
+            """:meth:`_group` of ``groups[gi]``, made once per call."""
+            found = prepared.get(gi)
+            if found is None:
+                found = prepared[gi] = self._group(groups[gi])
+            return found
+
         def solve(win: list[list[Held]], gi: int) -> list[BassStep]:
             times = [g[0].note.time_s for g in win]
             last = groups[gi - 1][0].note.time_s if gi > 0 else self.last_fixed_t
@@ -51,14 +60,14 @@ class BassChain(Chain[Held]):
             gaps += [b - a for a, b in zip(times, times[1:], strict=False)]
             sol = bass_mod.solve(
                 self.state,
-                [self._group(g)[1] for g in win],
+                [prepare(gi + i)[1] for i in range(len(win))],
                 self.ctx.config.bass.fingering,
                 gaps,
             )
             return list(zip(sol.choice, sol.costs, sol.states, strict=True))
 
         for gi in range(n_groups):
-            kept, opts = self._group(groups[gi])
+            kept, opts = prepare(gi)
             choice, cost, state = self.plan.step(groups, gi, solve)
             self._emit_group(groups[gi], kept, opts[choice], cost, state)
             self.state = state

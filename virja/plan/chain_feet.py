@@ -12,12 +12,18 @@ The left foot also takes the hi-hat notes the hands give it
 
 from __future__ import annotations
 
+import math
+from itertools import repeat
+from operator import itemgetter, sub
+
 from virja.plan import drums as drums_mod
 from virja.plan.chain import GROUP_EPS_S, ChainContext
-from virja.plan.chain_kit import HAND_WINDOW_S, REBOUND_VELOCITY, DrumChain, DrumHeld
+from virja.plan.chain_kit import HAND_WINDOW_S, REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
 from virja.plan.timing import align
-from virja.vocab import DrumStroke, Limb
+from virja.vocab import Limb
+
+_TIME = itemgetter(0)  # of a fixed stroke: (time, planned note)
 
 
 class FootChain(DrumChain):
@@ -72,20 +78,22 @@ class FootChain(DrumChain):
 
     # the hi-hat notes the hands give this foot -------------------------------------
 
-    def _near(self) -> list[float]:
-        """The times of this foot's strokes fixed, pending and last."""
-        near = [ft for ft, _p in self.fixed] + [r.note.time_s for r in self.pending]
+    def _nearest(self, t: float) -> float:
+        """How far from ``t`` the nearest of this foot's strokes fixed, pending and last
+        is (inf: none).  Asked for every hi-hat stroke the hands plan: one pass."""
+        d = min(map(abs, map(sub, map(_TIME, self.fixed), repeat(t))), default=math.inf)
+        if self.pending:
+            d = min(d, min(abs(r.note.time_s - t) for r in self.pending))
         if self.state is not None:
-            near.append(self.state)
-        return near
+            d = min(d, abs(self.state - t))
+        return d
 
     def can_chick(self, t: float) -> bool:
-        """The foot plays the hi-hat at ``t`` already, or can."""
-        near = self._near()
+        """The foot plays the hi-hat at ``t`` already (a stroke within HAND_WINDOW_S),
+        or can (none within its ``min_interval_s``)."""
+        d = self._nearest(t)
         min_int = self.ctx.config.timing.get("hihat_pedal").min_interval_s
-        return any(abs(ft - t) <= HAND_WINDOW_S for ft in near) or not any(
-            abs(ft - t) < min_int - drums_mod.TIME_EPS_S for ft in near
-        )
+        return d <= HAND_WINDOW_S or not d < min_int - drums_mod.TIME_EPS_S
 
     def chick(self, rec: DrumHeld) -> bool:
         """A hi-hat note both hands are too busy for, played by this foot (a chick on
@@ -95,10 +103,10 @@ class FootChain(DrumChain):
         t = rec.note.time_s
         timing = self.ctx.config.timing
         min_int = timing.get("hihat_pedal").min_interval_s
-        near = self._near()
-        if any(abs(ft - t) <= HAND_WINDOW_S for ft in near):
+        d = self._nearest(t)
+        if d <= HAND_WINDOW_S:
             shared = True  # the foot plays the hi-hat then: the note rides on that chick
-        elif any(abs(ft - t) < min_int - drums_mod.TIME_EPS_S for ft in near):
+        elif d < min_int - drums_mod.TIME_EPS_S:
             return False
         else:
             shared = False
@@ -110,7 +118,7 @@ class FootChain(DrumChain):
             piece="hihat",
             string=None,
             fret=None,
-            motion=DrumStroke("hihat", self.limb),
+            motion=drum_stroke("hihat", self.limb),
             cost=0.0,
         )
         if not shared and (self.state is None or t > self.state):

@@ -21,10 +21,9 @@ from dataclasses import dataclass
 from virja.plan import drums as drums_mod
 from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
 from virja.plan.chain_feet import FootChain
-from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld
+from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
 from virja.plan.types import PlannedNote
-from virja.vocab import DrumStroke, as_limb, as_piece
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
 # double trigger): the later ones ride on the first stroke, each at its own time.
@@ -80,21 +79,24 @@ def hand_group(
     """
     if not group:
         return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
+    if len(group) == 1:  # one note: one stroke (what the loops below make of it)
+        r = group[0]
+        stroke = drums_mod.Stroke(
+            r.drum.piece,
+            velocity_priority(r.drum.priority, r.note.velocity),
+            r.note.time_s - t0,
+            chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+        )
+        return HandGroupPlan(drums_mod.HandGroup(t0, (stroke,)), [[r]], [], [])
     clusters: list[list[DrumHeld]] = []
     for r in sorted(group, key=lambda r: (r.note.time_s, r.seq)):
-        same = next(
-            (
-                c
-                for c in clusters
-                if c[0].drum.piece == r.drum.piece
-                and r.note.time_s - c[0].note.time_s <= SAME_STROKE_S
-            ),
-            None,
-        )
-        if same is None:
-            clusters.append([r])
+        piece, t = r.drum.piece, r.note.time_s
+        for c in clusters:  # the first cluster of its piece begun within SAME_STROKE_S
+            if c[0].drum.piece == piece and t - c[0].note.time_s <= SAME_STROKE_S:
+                c.append(r)
+                break
         else:
-            same.append(r)
+            clusters.append([r])
 
     ranks = [
         (
@@ -113,7 +115,7 @@ def hand_group(
     bounces: list[tuple[int, list[DrumHeld]]] = []
     extra: list[DrumHeld] = []
     for c in ranked:
-        if any(c is k for k in kept):
+        if c is kept[0] or (len(kept) == 2 and c is kept[1]):
             continue
         piece = c[0].drum.piece
         near = [
@@ -448,20 +450,20 @@ def _unfixed(rec: DrumHeld, piece: str, hand: str, timed: DrumHeld) -> PlannedNo
     """``rec`` as a planned note not yet fixed: struck by ``hand`` on ``piece`` with the
     start and impact of ``timed`` (the stroke's first note, or itself)."""
     n = rec.note
-    stroke = DrumStroke(as_piece(piece), as_limb(hand))
-    return PlannedNote(
-        time=n.time_s,
-        performer=rec.performer,
-        channel=n.channel,
-        note=rec.played,
-        velocity=n.velocity,
-        limb=stroke.limb,
-        piece=stroke.piece,
-        string=None,
-        fret=None,
-        motion=stroke,
-        start=timed.start,
-        impact=timed.impact,
-        cost=0.0,
-        late=timed.late,
+    stroke = drum_stroke(piece, hand)
+    return PlannedNote.of(
+        n.time_s,
+        rec.performer,
+        n.channel,
+        rec.played,
+        n.velocity,
+        stroke.limb,
+        stroke.piece,
+        None,
+        None,
+        stroke,
+        timed.start,
+        timed.impact,
+        0.0,
+        timed.late,
     )

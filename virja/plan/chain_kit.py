@@ -25,6 +25,19 @@ HAND_WINDOW_S = 0.030
 # once more), heard at its own time and played by the same stroke.
 REBOUND_VELOCITY = 16
 
+# the stroke of each (piece, limb) made so far: a stroke is frozen, so one is shared by
+# every note it plays (a kit has a few dozen)
+_STROKES: dict[tuple[str, str], DrumStroke] = {}
+
+
+def drum_stroke(piece: str, limb: str) -> DrumStroke:
+    """``DrumStroke(piece, limb)``, checked (``ValueError`` for an unknown one) and made
+    once."""
+    stroke = _STROKES.get((piece, limb))
+    if stroke is None:
+        stroke = _STROKES[(piece, limb)] = DrumStroke(as_piece(piece), as_limb(limb))
+    return stroke
+
 
 @dataclass(slots=True, kw_only=True)
 class DrumHeld(Held):
@@ -56,7 +69,7 @@ class DrumChain(Chain[DrumHeld]):
     def emit_stroke(self, recs: Sequence[Held], piece: str, limb: str, cost: float) -> None:
         """One stroke for ``recs`` (the same piece at once): shared motion, start and impact."""
         first = recs[0]
-        stroke = DrumStroke(as_piece(piece), as_limb(limb))
+        stroke = drum_stroke(piece, limb)
         for i, rec in enumerate(recs):
             rec.start, rec.impact, rec.late = first.start, first.impact, first.late
             self.emit(

@@ -229,27 +229,56 @@ _Played = tuple[
     int,
     float,
 ]
+# a hand's steps per previous piece with each penalty replaced by its class (as
+# :data:`_Steps`): (the largest time, ((time, class), ...))
+_Classed = dict[str | None, tuple[float, tuple[tuple[float, int], ...]]]
 
 
-def _needs(timing: Timing, piece: str | None) -> _Need:
-    """``Timing.stretch_gap(prev, piece) - TIME_EPS_S`` for every previous piece of a
-    hand (none included): the same floats :func:`transition` compares with, looked up
-    once."""
-    if piece is None:
-        return dict.fromkeys((None, *HAND_PIECES), -math.inf)
-    return {prev: timing.stretch_gap(prev, piece) - TIME_EPS_S for prev in (None, *HAND_PIECES)}
+def _needs(timing: Timing, piece: str | None) -> tuple[_Steps, _Need]:
+    """For every previous piece of a hand (none included): :func:`_steps` with the
+    largest of their times, and ``Timing.stretch_gap(prev, piece) - TIME_EPS_S``: the
+    same floats :func:`transition` compares with, looked up once (made once per timing
+    and piece: shared, read only).  A hand that does not play (``piece`` None) has no
+    steps and needs -inf."""
+    global _needs_cache
+    entry = _needs_cache
+    if entry is None or entry[0] is not timing:
+        entry = _needs_cache = (timing, {})
+    found = entry[1].get(piece)
+    if found is None:
+        prevs: tuple[str | None, ...] = (None, *HAND_PIECES)
+        if piece is None:
+            found = (dict.fromkeys(prevs, (-math.inf, ())), dict.fromkeys(prevs, -math.inf))
+        else:
+            steps: _Steps = {}
+            for prev in prevs:
+                st = _steps(timing, prev, piece)
+                steps[prev] = (max((time for time, _pen in st), default=-math.inf), st)
+            reach: _Need = {prev: timing.stretch_gap(prev, piece) - TIME_EPS_S for prev in prevs}
+            found = (steps, reach)
+        entry[1][piece] = found
+    return found
 
 
-def _all_steps(timing: Timing, piece: str | None) -> _Steps:
-    """:func:`_steps` for every previous piece of a hand (none included); none at all
-    when the hand does not play."""
-    if piece is None:
-        return dict.fromkeys((None, *HAND_PIECES), (-math.inf, ()))
-    out: _Steps = {}
-    for prev in (None, *HAND_PIECES):
-        steps = _steps(timing, prev, piece)
-        out[prev] = (max((time for time, _pen in steps), default=-math.inf), steps)
-    return out
+# the needs of the last timing used (matched by identity, as _cache below): a piece's
+# needs do not depend on the stroke's offset or priority, which make most signatures
+_needs_cache: tuple[Timing, dict[str | None, tuple[_Steps, _Need]]] | None = None
+
+
+def _classed(steps: _Steps, scale: int) -> tuple[_Classed, list[float]]:
+    """A hand's steps with each penalty numbered: the penalties it may pay (0.0 first,
+    for none, then each distinct one as met) and the steps with ``number * scale`` in
+    place of the penalty."""
+    levels = [0.0]
+    out: _Classed = {}
+    for prev, (limit, st) in steps.items():
+        classed = []
+        for time, pen in st:
+            if pen not in levels:
+                levels.append(pen)
+            classed.append((time, levels.index(pen) * scale))
+        out[prev] = (limit, tuple(classed))
+    return out, levels
 
 
 @dataclass(frozen=True, slots=True)
@@ -259,12 +288,22 @@ class _Compiled:
     options: tuple[_Option, ...]  # in :func:`options` order
     played: tuple[_Played, ...]  # the options that play something, in the same order
     drop_penalty: float  # of the last option, which drops every stroke
+    # per played option, for :func:`solve`: the right hand's (dt, reach, classed steps),
+    # the left hand's, and the penalty by class ``right * n_left + left`` (the classes
+    # number the penalties each hand may pay, 0 for none), the hands' penalties added
+    # as :func:`transition` does (the left hand's first)
+    right_plays: tuple[tuple[float, _Need, _Classed], ...]
+    left_plays: tuple[tuple[float, _Need, _Classed], ...]
+    pens: tuple[tuple[float, ...], ...]
 
 
 def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
     """The options of :func:`options` for ``strokes``, precompiled, in the same order."""
     opts = []
     flat: list[_Played] = []
+    right_plays = []
+    left_plays = []
+    pens = []
     for k, assign in enumerate(options(HandGroup(0.0, strokes))):
         played = []
         penalty = 0.0
@@ -281,26 +320,50 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
             hand_of = {is_right: (piece, dt) for is_right, _m, piece, dt, _i in played}
             r_piece, r_dt = hand_of.get(True, (None, 0.0))
             l_piece, l_dt = hand_of.get(False, (None, 0.0))
+            r_steps, r_reach = _needs(timing, r_piece)
+            l_steps, l_reach = _needs(timing, l_piece)
             first, last = played[0][1], played[-1][1]
             flat.append(
                 (
                     k,
                     r_piece,
                     r_dt,
-                    _all_steps(timing, r_piece),
-                    _needs(timing, r_piece),
+                    r_steps,
+                    r_reach,
                     l_piece,
                     l_dt,
-                    _all_steps(timing, l_piece),
-                    _needs(timing, l_piece),
+                    l_steps,
+                    l_reach,
                     last,
                     penalty,
                     first,
                     costs.table[first][last] if len(played) == 2 else 0.0,
                 )
             )
+            l_classed, l_levels = _classed(l_steps, 1)
+            n_left = len(l_levels)
+            r_classed, r_levels = _classed(r_steps, n_left)
+            right_plays.append((r_dt, r_reach, r_classed))
+            left_plays.append((l_dt, l_reach, l_classed))
+            by_class = []
+            for r_pen in r_levels:
+                for l_pen in l_levels:
+                    total = penalty
+                    if l_pen:  # as solve's plain loop: a penalty only when a step is met
+                        total = total + l_pen
+                    if r_pen:
+                        total = total + r_pen
+                    by_class.append(total)
+            pens.append(tuple(by_class))
     assert not opts[-1].played  # the all-drop option is last
-    return _Compiled(tuple(opts), tuple(flat), opts[-1].penalty)
+    return _Compiled(
+        tuple(opts),
+        tuple(flat),
+        opts[-1].penalty,
+        tuple(right_plays),
+        tuple(left_plays),
+        tuple(pens),
+    )
 
 
 # Compiled options depend only on (costs, timing, strokes), not on the group's time, so
@@ -328,9 +391,84 @@ def _compiled(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> 
     return comp
 
 
-# A move out of states with given hand times: (option index, penalty, first motion,
-# pair cost, index of the state it leads to in the next layer).
-_Move = tuple[int, float, int, float, int]
+# A played option as one layer of the solver uses it: (option index, its penalty by
+# the sum of the hands' classes (:class:`_Compiled`), first played motion, table cost first -> second
+# played motion, target key less the hands it leaves as they were, which hands those
+# are: 1 the right hand, 2 the left, 3 both (0: both play)).
+_Step = tuple[int, tuple[float, ...], int, float, int, int]
+# a layer's parts: (previous motion, its time); a hand's (last stroke time, its piece)
+_Row = tuple[int | None, float | None]
+_Sub = tuple[float | None, str | None]
+_INFEASIBLE = -(1 << 40)  # a hand's class for an option it cannot play in time (sums stay < 0)
+
+
+@dataclass(slots=True)
+class _Layer:
+    """The states after a group, by parts: each state is a row (previous motion and its
+    time) and a stroke per hand, numbered in ``rows``, ``rights`` and ``lefts``; state
+    ``i`` is ``keys[i] = (row * len(rights) + right) * len(lefts) + left``.  ``came``:
+    where each state came from, ``previous state * n_options + option``."""
+
+    rows: list[_Row]
+    rights: list[_Sub]
+    lefts: list[_Sub]
+    keys: list[int]
+    came: list[int]
+    n_options: int
+
+    def parts(self, i: int) -> tuple[int, int, int]:
+        """The numbers of state ``i``'s row, right hand's and left hand's parts."""
+        ri, hands = divmod(self.keys[i], len(self.rights) * len(self.lefts))
+        rh, lh = divmod(hands, len(self.lefts))
+        return ri, rh, lh
+
+    def state(self, i: int) -> HandState:
+        ri, rh, lh = self.parts(i)
+        prev, prev_t = self.rows[ri]
+        t_right, p_right = self.rights[rh]
+        t_left, p_left = self.lefts[lh]
+        return (prev, prev_t, t_right, t_left, p_right, p_left)
+
+
+def _hand_parts(
+    parts: list[_Sub],
+    t: float,
+    max_interval: float,
+    next_parts: dict[tuple[object, object], int],
+    plays: tuple[tuple[float, _Need, _Classed], ...],
+) -> tuple[list[int], list[list[int]]]:
+    """For one hand's parts (last stroke time, piece) of a layer, before a group at
+    ``t``: each part's number in the next layer once :func:`_canonical` has kept or
+    forgotten it (numbered in ``next_parts`` as met), and its class per played option
+    (``plays``: this hand's dt, reach and classed steps, :class:`_Compiled`): the class
+    of the first step it comes sooner than (0: none, the penalty it pays numbered),
+    :data:`_INFEASIBLE` too soon."""
+    kept: list[int] = []
+    classes: list[list[int]] = []
+    for last, piece in parts:
+        if last is None:
+            since = math.inf
+            part: _Sub = (last, piece)
+        else:
+            since = t - last
+            part = (None, None) if since >= max_interval else (last, piece)
+        kept.append(next_parts.setdefault(part, len(next_parts)))
+        row: list[int] = []
+        for dt, reach, classed in plays:
+            x = since + dt
+            if x < reach[piece]:
+                row.append(_INFEASIBLE)
+                continue
+            c = 0
+            limit, steps = classed[piece]
+            if x < limit:
+                for time, cls in steps:
+                    if x < time:
+                        c = cls
+                        break
+            row.append(c)
+        classes.append(row)
+    return kept, classes
 
 
 def solve(
@@ -351,22 +489,29 @@ def solve(
     The loop is reorganised for speed without changing any result:
 
     - Options are compiled once per stroke signature (:func:`_compiled`).
-    - Whether an option is feasible, and the hand times after it, depend only on the
-      source state's hand times ``(t_right, t_left)``, which several states share
-      (they differ in the previous motion).  So per group the feasible moves are
-      built once per distinct pair of hand times, with their target states already
-      looked up; a played option's target does not depend on the previous motion.
-      What does depend on it is only the first played stroke's cost: one table row
-      per state.  The all-drop option is always feasible and always last.
-      Feasibility is ``not (t - last < need)`` per hand, with ``t - last`` = inf for
-      a hand with no recent stroke and ``need`` = -inf for a hand that does not play:
-      the same comparisons as :func:`transition`.
-    - The states of a layer are numbered in the order they are first reached, and
-      the layer is kept as lists indexed by that number (cost, back-pointer).  A
-      target is numbered when its move is built, which happens at the first state
-      with those hand times, in visiting order, just before its candidates are
-      merged; so the numbering is exactly the insertion order of the dictionary the
-      plain DP would build, and the next layer is visited in the same order.
+    - A state is three parts: the row (previous motion and its time) and each hand's
+      last stroke (time and piece).  A layer numbers its distinct parts and keeps,
+      per state, the three numbers; the next layer's states are keyed by the integer
+      ``(row * n_rights + right) * n_lefts + left`` over the next layer's parts,
+      which are all known before the states are visited (each is a part of this
+      layer kept or forgotten by :func:`_canonical`, or one a played option makes).
+    - Whether an option is feasible, and what penalty each hand pays for it (at a
+      stretch, at speed: :func:`stroke_penalty`), depend on one hand's part only:
+      worked out once per distinct part and option (a class: 0 for no penalty, else
+      the penalty's number among those the hand may pay for that option, the right
+      hand's times the number of the left's; :data:`_INFEASIBLE` too soon), the same
+      comparisons as :func:`transition` (``t - last + dt`` against
+      :meth:`Timing.stretch_gap` less TIME_EPS_S, then each of :func:`_steps` in
+      order; inf for a hand with no recent stroke, -inf needed by a hand that does
+      not play).  The sum of the two classes indexes the option's penalty with those
+      two hands' penalties added, the left hand's first, as :func:`transition` does.
+    - A played option's target keeps the row it makes, the part of each hand that
+      plays and the kept part of a hand that does not; dropping every stroke keeps
+      the kept parts (the previous motion forgotten once ``rest_s`` old).  The
+      table row a state's first played motion pays is looked up once per row.
+    - A target is numbered at the first candidate reaching it, so the numbering is
+      exactly the insertion order of the dictionary the plain DP would build, and
+      the next layer is visited in the same order.
     - Each total is summed in the same order as the plain DP (``acc + penalty +
       first + pair``, which matters once costs are fractions) and merged with the
       same strict ``<``, so ties resolve as before.  ``pair`` is 0.0 for a single
@@ -383,12 +528,13 @@ def solve(
     table = costs.table
     none_row = table[costs.none_row]
     inf = math.inf
-    layer: list[HandState] = [state]  # the states reached, in first-reached order
-    accs: list[float] = [0.0]  # least objective reaching each
-    # back-pointers per group: the previous layer's state and the option index; the
+    prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
+    start = _Layer([(prev0, prev_t0)], [(t_right0, p_right0)], [(t_left0, p_left0)], [0], [0], 1)
+    layer = start
+    accs: list[float] = [0.0]  # least objective reaching each state of the layer
+    # per group: the layer after it, with its back-pointers (``_Layer.came``); the
     # per-stroke costs are recomputed once on the way back
-    backs: list[tuple[list[int], list[int]]] = []
-    layers: list[list[HandState]] = []
+    layers: list[_Layer] = []
     compiled_all = []
     for group in groups:
         t = group.time
@@ -397,124 +543,107 @@ def solve(
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
         played_opts = comp.played
-        moves_by_hands: dict[
-            tuple[float | None, float | None, str | None, str | None],
-            tuple[list[_Move], float | None, float | None, str | None, str | None],
-        ] = {}
-        index: dict[HandState, int] = {}  # next layer: state -> its number
-        nxt: list[HandState] = []
-        # inf until reached (every total is finite); every state is reached by the
-        # candidate that numbers it
-        nacc: list[float] = []
-        back_s: list[int] = []
-        back_k: list[int] = []
-        for sid, acc in enumerate(accs):
-            prev, prev_t, t_right, t_left, p_right, p_left = layer[sid]
-            hands = (t_right, t_left, p_right, p_left)
-            entry = moves_by_hands.get(hands)
-            if entry is None:
-                # hand times kept after the group (_canonical): forgotten once no
-                # later group can be constrained by them
-                keep_r, keep_pr = (
-                    (None, None)
-                    if t_right is not None and t - t_right >= max_interval
-                    else (t_right, p_right)
-                )
-                keep_l, keep_pl = (
-                    (None, None)
-                    if t_left is not None and t - t_left >= max_interval
-                    else (t_left, p_left)
-                )
-                since_r = inf if t_right is None else t - t_right
-                since_l = inf if t_left is None else t - t_left
-                moves: list[_Move] = []
-                for (
-                    k,
-                    r_piece,
-                    r_dt,
-                    r_steps,
-                    r_reach,
-                    l_piece,
-                    l_dt,
-                    l_steps,
-                    l_reach,
-                    last,
-                    penalty,
-                    first,
-                    pair,
-                ) in played_opts:
-                    # a hand that does not play needs -inf: never infeasible
-                    r_since, l_since = since_r + r_dt, since_l + l_dt
-                    if r_since < r_reach[p_right] or l_since < l_reach[p_left]:
-                        continue
-                    # at a stretch, at speed (stroke_penalty): the left hand's first
-                    limit, steps = l_steps[p_left]
-                    if l_since < limit:
-                        for time, pen in steps:
-                            if l_since < time:
-                                penalty = penalty + pen
-                                break
-                    limit, steps = r_steps[p_right]
-                    if r_since < limit:
-                        for time, pen in steps:
-                            if r_since < time:
-                                penalty = penalty + pen
-                                break
-                    nr, npr = keep_r, keep_pr
-                    if r_piece is not None:
-                        nr = None if t - (t + r_dt) >= max_interval else t + r_dt
-                        npr = None if nr is None else r_piece
-                    nl, npl = keep_l, keep_pl
-                    if l_piece is not None:
-                        nl = None if t - (t + l_dt) >= max_interval else t + l_dt
-                        npl = None if nl is None else l_piece
-                    new = (last, t, nr, nl, npr, npl)
-                    nid = index.get(new)
-                    if nid is None:
-                        nid = index[new] = len(nxt)
-                        nxt.append(new)
-                        nacc.append(inf)
-                        back_s.append(0)
-                        back_k.append(0)
-                    moves.append((k, penalty, first, pair, nid))
-                entry = moves_by_hands[hands] = (moves, keep_r, keep_l, keep_pr, keep_pl)
-            moves, keep_r, keep_l, keep_pr, keep_pl = entry
-            recent = prev_t is not None and t - prev_t < rest_s
-            row = table[prev] if prev is not None and recent else none_row
-            for k, penalty, first, pair, nid in moves:
-                total = acc + penalty + row[first] + pair
-                if total < nacc[nid]:
-                    nacc[nid] = total
-                    back_s[nid] = sid
-                    back_k[nid] = k
-            # dropping every stroke: the previous motion is forgotten once rest_s old
-            dropped: HandState = (
-                (None, None, keep_r, keep_l, keep_pr, keep_pl)
-                if prev_t is not None and t - prev_t >= rest_s
-                else (prev, prev_t, keep_r, keep_l, keep_pr, keep_pl)
-            )
-            nid = index.get(dropped)
-            if nid is None:
-                nid = index[dropped] = len(nxt)
-                nxt.append(dropped)
-                nacc.append(inf)
-                back_s.append(0)
-                back_k.append(0)
+        next_rows: dict[tuple[object, object], int] = {}
+        next_rights: dict[tuple[object, object], int] = {}
+        next_lefts: dict[tuple[object, object], int] = {}
+        # per row of this layer: the table row its first played motion pays, and the
+        # row kept when every stroke is dropped
+        row_costs: list[tuple[float, ...]] = []
+        row_kept: list[int] = []
+        for prev, prev_t in layer.rows:
+            if prev_t is not None and t - prev_t >= rest_s:
+                row_costs.append(none_row)
+                row_kept.append(next_rows.setdefault((None, None), len(next_rows)))
+            else:
+                recent = prev_t is not None
+                row_costs.append(table[prev] if prev is not None and recent else none_row)
+                row_kept.append(next_rows.setdefault((prev, prev_t), len(next_rows)))
+        right_kept, right_class = _hand_parts(
+            layer.rights, t, max_interval, next_rights, comp.right_plays
+        )
+        left_kept, left_class = _hand_parts(
+            layer.lefts, t, max_interval, next_lefts, comp.left_plays
+        )
+        # the parts each played option makes
+        made: list[tuple[int, int, int]] = []
+        for _k, r_piece, r_dt, _rn, _rr, l_piece, l_dt, _ln, _lr, last, *_ in played_opts:
+            nr = -1
+            if r_piece is not None:
+                tr = None if t - (t + r_dt) >= max_interval else t + r_dt
+                nr = next_rights.setdefault((tr, None if tr is None else r_piece), len(next_rights))
+            nl = -1
+            if l_piece is not None:
+                tl = None if t - (t + l_dt) >= max_interval else t + l_dt
+                nl = next_lefts.setdefault((tl, None if tl is None else l_piece), len(next_lefts))
+            made.append((next_rows.setdefault((last, t), len(next_rows)), nr, nl))
+        n_rights, n_lefts = len(next_rights), len(next_lefts)
+        n_rl = n_rights * n_lefts
+        steps: list[_Step] = []
+        for played, pens, (nrow, nr, nl) in zip(played_opts, comp.pens, made, strict=True):
+            k, first, pair = played[0], played[11], played[12]
+            base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
+            steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
+        # the next layer, by state key in first-reached order (a dictionary keeps the
+        # order of insertion): least objective, and where it came from as
+        # ``state * n_options + option``
+        reached: dict[int, float] = {}
+        came: dict[int, int] = {}
+        n_options = drop_k + 1
+        get = reached.get
+        cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
+        for sid, (key, acc) in enumerate(zip(layer.keys, accs, strict=True)):
+            ri, hands = divmod(key, cur_rl)
+            rh, lh = divmod(hands, cur_lefts)
+            row = row_costs[ri]
+            keep_r = right_kept[rh] * n_lefts
+            keep_l = left_kept[lh]
+            # what a step adds to its base key: the hands it leaves as they were
+            kept_keys = (0, keep_r, keep_l, keep_r + keep_l)
+            here = sid * n_options
+            for (k, pens, first, pair, base, keeps), rc, lc in zip(
+                steps, right_class[rh], left_class[lh], strict=True
+            ):
+                c = rc + lc
+                if c < 0:
+                    continue
+                key = base + kept_keys[keeps]
+                total = acc + pens[c] + row[first] + pair
+                old = get(key)
+                if old is None:  # reached first: numbered now (as inf, then merged)
+                    reached[key] = total
+                    came[key] = here + k if total < inf else 0
+                elif total < old:
+                    reached[key] = total
+                    came[key] = here + k
+            # dropping every stroke: the row and hands as kept
+            key = row_kept[ri] * n_rl + kept_keys[3]
             total = acc + drop_pen
-            if total < nacc[nid]:
-                nacc[nid] = total
-                back_s[nid] = sid
-                back_k[nid] = drop_k
+            old = get(key)
+            if old is None:
+                reached[key] = total
+                came[key] = here + drop_k if total < inf else 0
+            elif total < old:
+                reached[key] = total
+                came[key] = here + drop_k
+        keys = list(reached)
+        nacc = list(reached.values())
+        codes = list(came.values())  # same order: both keyed when first reached
         if beam is not None:
-            kept = keep_best(nacc, beam)
-            if kept is not None:  # cut: the least-cost states, renumbered in order
-                nxt = [nxt[i] for i in kept]
-                nacc = [nacc[i] for i in kept]
-                back_s = [back_s[i] for i in kept]
-                back_k = [back_k[i] for i in kept]
-        layer, accs = nxt, nacc
-        layers.append(nxt)
-        backs.append((back_s, back_k))
+            kept_ids = keep_best(nacc, beam)
+            if kept_ids is not None:  # cut: the least-cost states, renumbered in order
+                keys = [keys[i] for i in kept_ids]
+                nacc = [nacc[i] for i in kept_ids]
+                codes = [codes[i] for i in kept_ids]
+        layer = _Layer(
+            list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order
+            list(next_rights),  # type: ignore[arg-type]
+            list(next_lefts),  # type: ignore[arg-type]
+            keys,
+            codes,
+            n_options,
+        )
+        accs = nacc
+        layers.append(layer)
     # the first state (in layer order) of least objective
     end = 0
     for i, acc in enumerate(accs):
@@ -525,9 +654,10 @@ def solve(
     states: list[HandState] = []
     cur = end
     for gi in range(len(groups) - 1, -1, -1):
-        back_s, back_k = backs[gi]
-        prev_id, k = back_s[cur], back_k[cur]
-        prev, prev_t = (layers[gi - 1] if gi > 0 else [state])[prev_id][:2]
+        after = layers[gi]
+        prev_id, k = divmod(after.came[cur], after.n_options)
+        before = layers[gi - 1] if gi > 0 else start
+        prev, prev_t = before.rows[before.parts(prev_id)[0]]
         opt = compiled_all[gi].options[k]
         r = (
             prev
@@ -540,7 +670,7 @@ def solve(
             r = m
         assigns.append(opt.assign)
         pers.append(tuple(per))
-        states.append(layers[gi][cur])
+        states.append(after.state(cur))
         cur = prev_id
     return HandSolution(
         tuple(reversed(assigns)), tuple(reversed(pers)), tuple(reversed(states)), accs[end]

@@ -6,7 +6,7 @@ time the note became known.  See docs/scheduler.md, "Impact alignment".
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from virja.plan.config import Timing
 
@@ -24,8 +24,10 @@ def anticipation_s(timing: Timing, kind: str, seconds_per_beat: float) -> float:
     return min(max(scaled, mt.min_anticipation_s), mt.anticipation_s)
 
 
-@dataclass(frozen=True)
-class Alignment:
+class Alignment(NamedTuple):
+    """When a note's motion starts, when it strikes, and whether that is after the note
+    (a tuple: made for every note the planner takes in, cheaply)."""
+
     start: float
     impact: float
     late: bool

@@ -75,6 +75,47 @@ class PlannedNote:
     cost: float
     late: bool
 
+    @classmethod
+    def of(
+        cls,
+        time: float,
+        performer: Performer,
+        channel: int,
+        note: int,
+        velocity: int,
+        limb: Limb,
+        piece: Piece | None,
+        string: BassString | None,
+        fret: int | None,
+        motion: MotionKey,
+        start: float,
+        impact: float,
+        cost: float,
+        late: bool,
+    ) -> PlannedNote:
+        """The same note as ``PlannedNote(...)`` (equal, same hash), made without the
+        frozen dataclass's ``object.__setattr__`` per field: the planner makes one per
+        note it plans, and those calls were about a tenth of a beat's planning
+        (docs/performance.md)."""
+        p = object.__new__(cls)
+        p.__dict__.update(
+            time=time,
+            performer=performer,
+            channel=channel,
+            note=note,
+            velocity=velocity,
+            limb=limb,
+            piece=piece,
+            string=string,
+            fret=fret,
+            motion=motion,
+            start=start,
+            impact=impact,
+            cost=cost,
+            late=late,
+        )
+        return p
+
     def to_json(self, origin_s: float = 0.0) -> dict[str, Any]:
         """A dict with exactly :data:`JSON_KEYS`, in that order; ``time``, ``start`` and
         ``impact`` in seconds from ``origin_s``, the session time of the input's start

@@ -8,9 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.motion.helpers import drum
+from tests.motion.helpers import assert_same_frames, drum, pose_live
 from virja.errors import ConfigError
-from virja.events import NoteOn
 from virja.geometry import GEOMETRY
 from virja.motion.band import BandAnimator, sticks
 from virja.motion.clip import MotionLibrary
@@ -241,19 +240,8 @@ def test_notes_known_early_but_planned_late_change_nothing_already_drawn(
     notes = sorted(_short_lead_notes(), key=lambda p: p.start)
     ts = np.arange(0.3, 7.0, 1 / 60)
     a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
-    drawn, told, k = [], 0, 0
-    for t in ts:
-        while told < len(notes) and _known_at(notes[told]) <= t:
-            n = notes[told]
-            a.note_known("drums", NoteOn(n.time, n.channel, n.note, n.velocity), t)
-            told += 1
-        while k < len(notes) and notes[k].start <= t:
-            a.add_planned(notes[k])
-            k += 1
-        drawn.append(a.local_rotations(float(t)))
-        a.mark_drawn(float(t))
-    again = a.local_rotations_many(ts)
-    np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
+    drawn = pose_live(a, notes, ts, _known_at)
+    assert_same_frames(a, ts, drawn)
     for p in notes:
         assert contact_distance(a, p, p.impact)[0] < 1e-4
 
@@ -323,15 +311,9 @@ def test_a_hand_gets_out_of_the_other_hands_way_on_a_cymbal(library: MotionLibra
     ]
     ts = np.arange(0.6, 2.0, 1 / 120)
     a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
-    drawn, k = [], 0
-    for t in ts:
-        while k < len(notes) and notes[k].start <= t:
-            a.add_planned(notes[k])
-            k += 1
-        drawn.append(a.local_rotations(float(t)))
-        a.mark_drawn(float(t))
+    drawn = pose_live(a, notes, ts)
+    assert_same_frames(a, ts, drawn)
     again = a.local_rotations_many(ts)
-    np.testing.assert_allclose(np.abs(np.sum(again * np.array(drawn), axis=-1)), 1.0, atol=1e-9)
     pos, rot = SKELETON.fk(again, a._roots)
     stk = sticks(pos[:, 0], rot[:, 0])
     d = _segment_distance(stk[:, 0, 0], stk[:, 0, 1], stk[:, 1, 0], stk[:, 1, 1])

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from tests.motion.helpers import drum
+from tests.motion.helpers import assert_same_frames, drum
 from virja.events import NoteOn
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary
@@ -67,11 +67,6 @@ def _play(
     return a, ts, np.array(drawn)
 
 
-def _same_frames(a: BandAnimator, ts: np.ndarray, drawn: np.ndarray) -> None:
-    again = a.local_rotations_many(ts)
-    np.testing.assert_allclose(np.abs(np.sum(again * drawn, axis=-1)), 1.0, atol=1e-9)
-
-
 def test_a_provisional_hand_leaves_when_the_note_is_known(library: MotionLibrary) -> None:
     """Ride, then the floor tom 0.4 s later planned with a 60 ms lead: told the
     provisional hand when the tom is known, the right hand crosses in time (under
@@ -82,7 +77,7 @@ def test_a_provisional_hand_leaves_when_the_note_is_known(library: MotionLibrary
     for told in (True, False):
         shown = [(0.5, [ride]), (0.9, [ride, tom])] if told else []
         a, ts, drawn = _play(library, [ride, tom], shown)
-        _same_frames(a, ts, drawn)
+        assert_same_frames(a, ts, drawn)
         fine = np.arange(0.3, 2.0, 1 / 120)
         w = _wrists(a, fine)[:, 1]
         speed = np.linalg.norm(np.diff(w, axis=0), axis=1) * 120
@@ -101,7 +96,7 @@ def test_the_plan_fixing_the_shown_hand_changes_nothing(library: MotionLibrary) 
     shown (every frame, before and after the fix), contacts exact."""
     notes = [_note("snare_left_hand", 1.0, 38), _note("crash_right_hand", 1.5, 49)]
     a, ts, drawn = _play(library, notes, [(0.5, notes[:1]), (1.0, notes[1:])])
-    _same_frames(a, ts, drawn)
+    assert_same_frames(a, ts, drawn)
     b = _animator(library)  # the whole input known: render's default, motion-report
     for p in notes:
         b.add_planned(p, known_at=p.impact - 0.5)
@@ -122,7 +117,7 @@ def test_a_revised_hand_changes_no_frame_drawn_and_moves_on_from_where_it_is(
     shown = _note("crash_right_hand", 1.5, 49)
     fixed = _note("crash_left_hand", 1.5, 49)
     a, ts, drawn = _play(library, [fixed], [(1.0, [shown])])
-    _same_frames(a, ts, drawn)
+    assert_same_frames(a, ts, drawn)
     assert a.provisional_counts["fixed_other"] == 1
     assert contact_distance(a, fixed, fixed.impact)[0] < 1e-4
     w = _wrists(a, np.arange(0.9, 2.0, 1 / 120))
@@ -144,7 +139,7 @@ def test_a_provisional_hand_revised_before_its_plan_and_taken_back(
     right = _note("tom_high_right_hand", 1.6, 48)
     left = _note("tom_high_left_hand", 1.6, 48)
     a, ts, drawn = _play(library, [], [(1.1, [right]), (1.3, [left]), (1.45, [])])
-    _same_frames(a, ts, drawn)
+    assert_same_frames(a, ts, drawn)
     assert a.provisional_counts["revised"] == 1
     assert a.provisional_counts["taken_back"] == 1
     w = _wrists(a, np.arange(1.0, 4.0, 1 / 120))

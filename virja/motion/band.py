@@ -232,6 +232,13 @@ class BandAnimator:
         key = (performer, int(note.channel), int(note.note), round(float(note.time_s), 9))
         self._known[key] = min(float(at_s), self._known.get(key, math.inf))
 
+    def _course(self, start: float, known_at: float | None) -> float:
+        """When a hand may change course for a stroke starting at ``start``: from when
+        its note became known (``known_at``, else its start), never at or before a
+        frame already shown (:attr:`drawn_until`)."""
+        course = start if known_at is None else min(known_at, start)
+        return max(course, self.drawn_until)
+
     def note_provisional(self, notes: Iterable[PlannedNoteLike]) -> None:
         """The plan's current hand for each drum note not yet started (the whole set:
         ``OnlinePlanner.provisional``): a free hand moves toward its piece from when
@@ -255,8 +262,7 @@ class BandAnimator:
             hand = clip.limb or p.limb
             if hand not in ("left_hand", "right_hand"):
                 continue
-            told = self._known.get(key, p.start)
-            course = max(min(told, p.start), self.drawn_until)
+            course = self._course(p.start, self._known.get(key))
             art = self.articulations.get(p.note)
             self.hands.add_stroke(
                 hand, course, p.impact, clip, p.velocity, art, key=key, drawn=self.drawn_until
@@ -299,8 +305,7 @@ class BandAnimator:
             )
             self._hits.add(Hit(p.impact, clip.piece or p.piece or "", p.velocity))
             art = self.articulations.get(p.note)
-            course = p.start if known_at is None else min(known_at, p.start)
-            course = max(course, self.drawn_until)
+            course = self._course(p.start, known_at)
             shown = self._provisional.pop(key, None)
             if shown is not None and shown[0] == limb and _same_stroke(shown[1], p):
                 self.hands.keep_stroke(limb, key)  # the stroke shown is the one played

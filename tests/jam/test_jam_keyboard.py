@@ -100,8 +100,18 @@ def test_controllers_go_to_drums_on_channel_10_and_nobody_elsewhere() -> None:
 
 
 def test_upper_drum_table_covers_the_papers_kit() -> None:
-    """Bass drum, snare, three toms, hi-hat (closed, open, pedal), ride and crash are reachable."""
-    assert {36, 38, 50, 47, 43, 42, 46, 44, 51, 49} == set(UPPER_DRUM_NOTES.values())
+    """Bass drum, snare, three toms, hi-hat (closed, open, pedal), ride and both crashes."""
+    assert {36, 38, 50, 47, 43, 42, 46, 44, 51, 49, 57} == set(UPPER_DRUM_NOTES.values())
+
+
+def test_g_sharp_plays_crash_2_on_its_own_piece() -> None:
+    """G# (MIDI 56 = G#3) sends GM 57, which the kit map puts on crash 2."""
+    from virja.plan.config import default_config
+
+    r = route(NoteOn(T, 0, 56, 100), KeyboardLayout(upper="drums"))
+    assert (r.performer, r.event.note) == ("drums", 57)
+    drum = default_config().kit.lookup(57)
+    assert drum is not None and drum.piece == "crash2"
 
 
 def test_bad_layouts_are_config_errors() -> None:
@@ -120,3 +130,4 @@ def test_routing_table_names_the_split_and_the_drum_keys() -> None:
     assert rows["keys below C3 (48)"] == "bass"
     assert rows["keys from C3 (48) up, every D"] == "drums: 38 Acoustic Snare"
     assert rows["keys from C3 (48) up, every D#"] == "nothing"
+    assert rows["keys from C3 (48) up, every G#"] == "drums: 57 Crash Cymbal 2"

@@ -37,8 +37,10 @@ DEFAULT_SPLIT = 48
 # Keys from the split up, with ``upper="drums"``: pitch class -> GM drum note.
 # Every octave above the split repeats the table, so a drummer's hand stays on
 # one octave.  White keys carry the kit of the paper (bass drum, snare, hi-hat,
-# three toms, ride); three black keys the pedal hi-hat, open hi-hat and crash.
-# D# and G# are left unmapped on purpose: a slip of the finger there makes no
+# three toms, ride); four black keys the pedal hi-hat, open hi-hat and the two
+# crashes (crash 2, the kit's right-hand crash beside the ride, on G# between the
+# toms).  D# is left unmapped on purpose: it lies between the snare and the
+# closed hi-hat, the two keys played most, so a slip of the finger there makes no
 # stroke rather than a wrong one.
 UPPER_DRUM_NOTES: dict[int, int] = {
     0: 36,  # C  -> Bass Drum 1 (right foot)
@@ -48,6 +50,7 @@ UPPER_DRUM_NOTES: dict[int, int] = {
     5: 43,  # F  -> High Floor Tom
     6: 46,  # F# -> Open Hi-Hat
     7: 47,  # G  -> Low-Mid Tom (the low tom)
+    8: 57,  # G# -> Crash Cymbal 2 (the right-hand crash)
     9: 50,  # A  -> High Tom
     10: 49,  # A# -> Crash Cymbal 1
     11: 51,  # B  -> Ride Cymbal 1
@@ -65,6 +68,7 @@ GM_DRUM_NAMES: dict[int, str] = {
     49: "Crash Cymbal 1",
     50: "High Tom",
     51: "Ride Cymbal 1",
+    57: "Crash Cymbal 2",
 }
 
 PITCH_NAMES = ("C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B")

@@ -27,6 +27,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from virja.plan import fastdp
 from virja.plan.bounds import keep_best
 from virja.plan.config import DrumCosts, Timing
 from virja.vocab import HAND_PIECES, Hand
@@ -471,6 +472,74 @@ def _hand_parts(
     return kept, classes
 
 
+def _merge_layer(
+    keys_in: list[int],
+    accs: list[float],
+    cur_rl: int,
+    cur_lefts: int,
+    row_costs: list[tuple[float, ...]],
+    row_kept: list[int],
+    right_kept: list[int],
+    right_class: list[list[int]],
+    left_kept: list[int],
+    left_class: list[list[int]],
+    steps: list[_Step],
+    n_rl: int,
+    n_lefts: int,
+    drop_k: int,
+    drop_pen: float,
+) -> tuple[list[int], list[float], list[int]]:
+    """One layer of :func:`solve`: every state of the layer (``keys_in``, ``accs``) with
+    every played option (``steps``) and then the option that drops every stroke, merged
+    into the next layer's states in first-reached order; returns their keys, least
+    objectives and back-pointers (``state * n_options + option``).  ``_dpcore.c``'s
+    ``hand_layer`` is this loop compiled."""
+    # the next layer, by state key in first-reached order (a dictionary keeps the
+    # order of insertion): least objective, and where it came from as
+    # ``state * n_options + option``
+    reached: dict[int, float] = {}
+    came: dict[int, int] = {}
+    n_options = drop_k + 1
+    inf = math.inf
+    get = reached.get
+    for sid, (key, acc) in enumerate(zip(keys_in, accs, strict=True)):
+        ri, hands = divmod(key, cur_rl)
+        rh, lh = divmod(hands, cur_lefts)
+        row = row_costs[ri]
+        keep_r = right_kept[rh] * n_lefts
+        keep_l = left_kept[lh]
+        # what a step adds to its base key: the hands it leaves as they were
+        kept_keys = (0, keep_r, keep_l, keep_r + keep_l)
+        here = sid * n_options
+        for (k, pens, first, pair, base, keeps), rc, lc in zip(
+            steps, right_class[rh], left_class[lh], strict=True
+        ):
+            c = rc + lc
+            if c < 0:
+                continue
+            key = base + kept_keys[keeps]
+            total = acc + pens[c] + row[first] + pair
+            old = get(key)
+            if old is None:  # reached first: numbered now (as inf, then merged)
+                reached[key] = total
+                came[key] = here + k if total < inf else 0
+            elif total < old:
+                reached[key] = total
+                came[key] = here + k
+        # dropping every stroke: the row and hands as kept
+        key = row_kept[ri] * n_rl + kept_keys[3]
+        total = acc + drop_pen
+        old = get(key)
+        if old is None:
+            reached[key] = total
+            came[key] = here + drop_k if total < inf else 0
+        elif total < old:
+            reached[key] = total
+            came[key] = here + drop_k
+    # the same order: both keyed when first reached
+    return list(reached), list(reached.values()), list(came.values())
+
+
 def solve(
     costs: DrumCosts,
     timing: Timing,
@@ -527,7 +596,6 @@ def solve(
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
-    inf = math.inf
     prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
     start = _Layer([(prev0, prev_t0)], [(t_right0, p_right0)], [(t_left0, p_left0)], [0], [0], 1)
     layer = start
@@ -583,51 +651,48 @@ def solve(
             k, first, pair = played[0], played[11], played[12]
             base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
             steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
-        # the next layer, by state key in first-reached order (a dictionary keeps the
-        # order of insertion): least objective, and where it came from as
-        # ``state * n_options + option``
-        reached: dict[int, float] = {}
-        came: dict[int, int] = {}
         n_options = drop_k + 1
-        get = reached.get
         cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
-        for sid, (key, acc) in enumerate(zip(layer.keys, accs, strict=True)):
-            ri, hands = divmod(key, cur_rl)
-            rh, lh = divmod(hands, cur_lefts)
-            row = row_costs[ri]
-            keep_r = right_kept[rh] * n_lefts
-            keep_l = left_kept[lh]
-            # what a step adds to its base key: the hands it leaves as they were
-            kept_keys = (0, keep_r, keep_l, keep_r + keep_l)
-            here = sid * n_options
-            for (k, pens, first, pair, base, keeps), rc, lc in zip(
-                steps, right_class[rh], left_class[lh], strict=True
-            ):
-                c = rc + lc
-                if c < 0:
-                    continue
-                key = base + kept_keys[keeps]
-                total = acc + pens[c] + row[first] + pair
-                old = get(key)
-                if old is None:  # reached first: numbered now (as inf, then merged)
-                    reached[key] = total
-                    came[key] = here + k if total < inf else 0
-                elif total < old:
-                    reached[key] = total
-                    came[key] = here + k
-            # dropping every stroke: the row and hands as kept
-            key = row_kept[ri] * n_rl + kept_keys[3]
-            total = acc + drop_pen
-            old = get(key)
-            if old is None:
-                reached[key] = total
-                came[key] = here + drop_k if total < inf else 0
-            elif total < old:
-                reached[key] = total
-                came[key] = here + drop_k
-        keys = list(reached)
-        nacc = list(reached.values())
-        codes = list(came.values())  # same order: both keyed when first reached
+        merged = None
+        core = fastdp.core
+        if core is not None:  # the same loop compiled (virja/plan/_dpcore.c)
+            merged = core.hand_layer(
+                layer.keys,
+                accs,
+                cur_rl,
+                cur_lefts,
+                row_costs,
+                row_kept,
+                right_kept,
+                right_class,
+                left_kept,
+                left_class,
+                steps,
+                n_rl,
+                n_lefts,
+                len(next_rows),
+                drop_k,
+                drop_pen,
+            )
+        if merged is None:
+            merged = _merge_layer(
+                layer.keys,
+                accs,
+                cur_rl,
+                cur_lefts,
+                row_costs,
+                row_kept,
+                right_kept,
+                right_class,
+                left_kept,
+                left_class,
+                steps,
+                n_rl,
+                n_lefts,
+                drop_k,
+                drop_pen,
+            )
+        keys, nacc, codes = merged
         if beam is not None:
             kept_ids = keep_best(nacc, beam)
             if kept_ids is not None:  # cut: the least-cost states, renumbered in order

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #define DPCORE_VERSION 1
+#define DPCORE_INFEASIBLE (-(1LL << 40)) /* virja.plan.drums._INFEASIBLE */
 #ifndef DPCORE_SOURCE_DIGEST /* set by tools/build_dpcore.py: the digest of this file */
 #define DPCORE_SOURCE_DIGEST ""
 #endif
@@ -233,6 +234,130 @@ done:
     free(out_tot);
     free(out_came);
     return result;
+}
+
+
+/* ------------------------------------------------------------ hand_parts */
+
+/* hand_parts(parts, t, max_interval, next_parts, plays) -> (kept, classes) or None:
+ * virja.plan.drums._hand_parts, the same comparisons in the same order. */
+static PyObject *hand_parts(PyObject *self, PyObject *args) {
+    PyObject *parts, *next_parts, *plays;
+    double t, max_interval;
+    if (!PyArg_ParseTuple(args, "OddOO", &parts, &t, &max_interval, &next_parts, &plays))
+        return NULL;
+    if (!PyList_Check(parts) || !PyDict_CheckExact(next_parts) || !PyTuple_Check(plays))
+        Py_RETURN_NONE;
+    Py_ssize_t n = PyList_GET_SIZE(parts), n_plays = PyTuple_GET_SIZE(plays);
+    double dts[64];
+    PyObject *reach[64], *classed[64];
+    if (n_plays > 64) Py_RETURN_NONE;
+    for (Py_ssize_t j = 0; j < n_plays; j++) {
+        PyObject *p = PyTuple_GET_ITEM(plays, j);
+        if (!PyTuple_Check(p) || PyTuple_GET_SIZE(p) != 3 ||
+            !PyFloat_CheckExact(PyTuple_GET_ITEM(p, 0)) ||
+            !PyDict_CheckExact(PyTuple_GET_ITEM(p, 1)) ||
+            !PyDict_CheckExact(PyTuple_GET_ITEM(p, 2)))
+            Py_RETURN_NONE;
+        dts[j] = PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(p, 0));
+        reach[j] = PyTuple_GET_ITEM(p, 1);
+        classed[j] = PyTuple_GET_ITEM(p, 2);
+    }
+    /* check every part first: (None, piece) or (float, piece) */
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *part = PyList_GET_ITEM(parts, i);
+        if (!PyTuple_CheckExact(part) || PyTuple_GET_SIZE(part) != 2) Py_RETURN_NONE;
+        PyObject *last = PyTuple_GET_ITEM(part, 0);
+        if (last != Py_None && !PyFloat_CheckExact(last)) Py_RETURN_NONE;
+    }
+    PyObject *kept = PyList_New(n), *classes = PyList_New(n);
+    if (!kept || !classes) goto fail;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *part = PyList_GET_ITEM(parts, i);
+        PyObject *last = PyTuple_GET_ITEM(part, 0), *piece = PyTuple_GET_ITEM(part, 1);
+        double since;
+        PyObject *key = part;
+        Py_INCREF(key);
+        if (last == Py_None) {
+            since = INFINITY;
+        } else {
+            since = t - PyFloat_AS_DOUBLE(last);
+            if (since >= max_interval) {
+                Py_DECREF(key);
+                key = PyTuple_Pack(2, Py_None, Py_None);
+                if (!key) goto fail;
+            }
+        }
+        PyObject *number = PyDict_GetItemWithError(next_parts, key);
+        if (number == NULL) {
+            if (PyErr_Occurred()) {
+                Py_DECREF(key);
+                goto fail;
+            }
+            number = PyLong_FromSsize_t(PyDict_GET_SIZE(next_parts));
+            if (!number || PyDict_SetItem(next_parts, key, number) < 0) {
+                Py_XDECREF(number);
+                Py_DECREF(key);
+                goto fail;
+            }
+        } else {
+            Py_INCREF(number);
+        }
+        Py_DECREF(key);
+        PyList_SET_ITEM(kept, i, number);
+        PyObject *row = PyList_New(n_plays);
+        if (!row) goto fail;
+        PyList_SET_ITEM(classes, i, row);
+        for (Py_ssize_t j = 0; j < n_plays; j++) {
+            double x = since + dts[j];
+            PyObject *need = PyDict_GetItemWithError(reach[j], piece);
+            PyObject *cl = need ? PyDict_GetItemWithError(classed[j], piece) : NULL;
+            if (!need || !cl || !PyFloat_CheckExact(need) || !PyTuple_Check(cl) ||
+                PyTuple_GET_SIZE(cl) != 2 || !PyFloat_CheckExact(PyTuple_GET_ITEM(cl, 0)) ||
+                !PyTuple_Check(PyTuple_GET_ITEM(cl, 1))) {
+                if (!PyErr_Occurred()) {
+                    Py_DECREF(kept);
+                    Py_DECREF(classes);
+                    /* next_parts may hold some of the parts now, numbered in the
+                     * order the Python loop numbers them: it starts over and finds
+                     * them so */
+                    Py_RETURN_NONE;
+                }
+                goto fail;
+            }
+            PyObject *c_obj = NULL;
+            if (x < PyFloat_AS_DOUBLE(need)) {
+                c_obj = PyLong_FromLongLong(DPCORE_INFEASIBLE);
+            } else {
+                PyObject *steps = PyTuple_GET_ITEM(cl, 1);
+                if (x < PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(cl, 0))) {
+                    for (Py_ssize_t q = 0; q < PyTuple_GET_SIZE(steps); q++) {
+                        PyObject *st = PyTuple_GET_ITEM(steps, q);
+                        double time = PyFloat_AsDouble(PyTuple_GET_ITEM(st, 0));
+                        if (time == -1.0 && PyErr_Occurred()) goto fail;
+                        if (x < time) {
+                            c_obj = PyTuple_GET_ITEM(st, 1);
+                            Py_INCREF(c_obj);
+                            break;
+                        }
+                    }
+                }
+                if (!c_obj) c_obj = PyLong_FromLong(0);
+            }
+            if (!c_obj) goto fail;
+            PyList_SET_ITEM(row, j, c_obj);
+        }
+    }
+    {
+        PyObject *res = PyTuple_Pack(2, kept, classes);
+        Py_DECREF(kept);
+        Py_DECREF(classes);
+        return res;
+    }
+fail:
+    Py_XDECREF(kept);
+    Py_XDECREF(classes);
+    return NULL;
 }
 
 /* ------------------------------------------------------------ bass_solve */
@@ -593,6 +718,7 @@ done:
 
 static PyMethodDef methods[] = {
     {"hand_layer", hand_layer, METH_VARARGS, "One layer of the hand DP (virja.plan.drums)."},
+    {"hand_parts", hand_parts, METH_VARARGS, "One hand's parts of a layer (virja.plan.drums)."},
     {"bass_solve", bass_solve, METH_VARARGS, "The bass DP (virja.plan.bass.solve)."},
     {NULL, NULL, 0, NULL},
 };

@@ -443,7 +443,14 @@ def _hand_parts(
     forgotten it (numbered in ``next_parts`` as met), and its class per played option
     (``plays``: this hand's dt, reach and classed steps, :class:`_Compiled`): the class
     of the first step it comes sooner than (0: none, the penalty it pays numbered),
-    :data:`_INFEASIBLE` too soon."""
+    :data:`_INFEASIBLE` too soon.  ``_dpcore.c``'s ``hand_parts`` is this loop compiled."""
+    core = fastdp.core
+    if core is not None:
+        found: tuple[list[int], list[list[int]]] | None = core.hand_parts(
+            parts, t, max_interval, next_parts, plays
+        )
+        if found is not None:
+            return found
     kept: list[int] = []
     classes: list[list[int]] = []
     for last, piece in parts:

@@ -360,6 +360,223 @@ fail:
     return NULL;
 }
 
+
+/* ------------------------------------------------------------ hand_step */
+
+/* setdefault(d, key, len(d)) -> the number (a new reference), NULL on error */
+static PyObject *number_of(PyObject *d, PyObject *key) {
+    PyObject *number = PyDict_GetItemWithError(d, key);
+    if (number) {
+        Py_INCREF(number);
+        return number;
+    }
+    if (PyErr_Occurred()) return NULL;
+    number = PyLong_FromSsize_t(PyDict_GET_SIZE(d));
+    if (number && PyDict_SetItem(d, key, number) < 0) {
+        Py_DECREF(number);
+        return NULL;
+    }
+    return number;
+}
+
+/* the number of the part (time t + dt, piece) a played hand makes, or of (None, None)
+ * when it is forgotten at once (as virja.plan.drums.solve): a new reference */
+static PyObject *made_part(PyObject *d, double t, double dt, double max_interval,
+                           PyObject *piece) {
+    double at = t + dt;
+    PyObject *key;
+    if (t - at >= max_interval) {
+        key = PyTuple_Pack(2, Py_None, Py_None);
+    } else {
+        PyObject *f = PyFloat_FromDouble(at);
+        if (!f) return NULL;
+        key = PyTuple_Pack(2, f, piece);
+        Py_DECREF(f);
+    }
+    if (!key) return NULL;
+    PyObject *number = number_of(d, key);
+    Py_DECREF(key);
+    return number;
+}
+
+/* hand_step(rows, rights, lefts, keys, accs, t, max_interval, rest_s, table, none_row,
+ *           played, pens, right_plays, left_plays, drop_k, drop_pen)
+ * -> (next rows, next rights, next lefts, keys, accs, codes) or None: one group of
+ * virja.plan.drums.solve, from the layer's parts to the next layer (the beam aside). */
+static PyObject *hand_step(PyObject *self, PyObject *args) {
+    PyObject *rows, *rights, *lefts, *keys, *accs, *t_o, *table, *none_row, *played, *pens;
+    PyObject *right_plays, *left_plays, *drop_pen_o;
+    double max_interval, rest_s;
+    long long drop_k;
+    if (!PyArg_ParseTuple(args, "OOOOOOddOOOOOOLO", &rows, &rights, &lefts, &keys, &accs,
+                          &t_o, &max_interval, &rest_s, &table, &none_row, &played, &pens,
+                          &right_plays, &left_plays, &drop_k, &drop_pen_o))
+        return NULL;
+    if (!PyList_Check(rows) || !PyList_Check(rights) || !PyList_Check(lefts) ||
+        !PyFloat_CheckExact(t_o) || !PyTuple_Check(table) || !PyTuple_Check(none_row) ||
+        !PyTuple_Check(played) || !PyTuple_Check(pens) ||
+        PyTuple_GET_SIZE(pens) != PyTuple_GET_SIZE(played))
+        Py_RETURN_NONE;
+    double t = PyFloat_AS_DOUBLE(t_o);
+    Py_ssize_t n_rows = PyList_GET_SIZE(rows), n_played = PyTuple_GET_SIZE(played);
+    Py_ssize_t n_table = PyTuple_GET_SIZE(table);
+    for (Py_ssize_t i = 0; i < n_rows; i++) {
+        PyObject *row = PyList_GET_ITEM(rows, i);
+        if (!PyTuple_CheckExact(row) || PyTuple_GET_SIZE(row) != 2) Py_RETURN_NONE;
+        PyObject *prev = PyTuple_GET_ITEM(row, 0), *prev_t = PyTuple_GET_ITEM(row, 1);
+        if ((prev != Py_None && !PyLong_CheckExact(prev)) ||
+            (prev_t != Py_None && !PyFloat_CheckExact(prev_t)))
+            Py_RETURN_NONE;
+    }
+    for (Py_ssize_t j = 0; j < n_played; j++) {
+        PyObject *op = PyTuple_GET_ITEM(played, j);
+        if (!PyTuple_Check(op) || PyTuple_GET_SIZE(op) != 13 ||
+            !PyFloat_Check(PyTuple_GET_ITEM(op, 2)) || !PyFloat_Check(PyTuple_GET_ITEM(op, 6)))
+            Py_RETURN_NONE;
+    }
+    PyObject *result = NULL, *next_rows = NULL, *next_rights = NULL, *next_lefts = NULL;
+    PyObject *row_costs = NULL, *row_kept = NULL, *r_parts = NULL, *l_parts = NULL;
+    PyObject *steps = NULL, *merged = NULL, *none_key = NULL, *call = NULL;
+    next_rows = PyDict_New();
+    next_rights = PyDict_New();
+    next_lefts = PyDict_New();
+    row_costs = PyList_New(n_rows);
+    row_kept = PyList_New(n_rows);
+    none_key = PyTuple_Pack(2, Py_None, Py_None);
+    if (!next_rows || !next_rights || !next_lefts || !row_costs || !row_kept || !none_key)
+        goto done;
+    for (Py_ssize_t i = 0; i < n_rows; i++) {
+        PyObject *row = PyList_GET_ITEM(rows, i);
+        PyObject *prev = PyTuple_GET_ITEM(row, 0), *prev_t = PyTuple_GET_ITEM(row, 1);
+        PyObject *cost_row = none_row, *key = row, *number;
+        if (prev_t != Py_None && t - PyFloat_AS_DOUBLE(prev_t) >= rest_s) {
+            key = none_key;
+        } else if (prev != Py_None && prev_t != Py_None) {
+            Py_ssize_t at = PyLong_AsSsize_t(prev);
+            if (at == -1 && PyErr_Occurred()) goto done;
+            if (at < 0 || at >= n_table) {
+                result = Py_None;
+                Py_INCREF(result);
+                goto done;
+            }
+            cost_row = PyTuple_GET_ITEM(table, at);
+        }
+        number = number_of(next_rows, key);
+        if (!number) goto done;
+        Py_INCREF(cost_row);
+        PyList_SET_ITEM(row_costs, i, cost_row);
+        PyList_SET_ITEM(row_kept, i, number);
+    }
+    call = Py_BuildValue("(OddOO)", rights, t, max_interval, next_rights, right_plays);
+    if (!call) goto done;
+    r_parts = hand_parts(NULL, call);
+    Py_CLEAR(call);
+    if (!r_parts || r_parts == Py_None) {
+        if (r_parts == Py_None) result = r_parts, r_parts = NULL;
+        goto done;
+    }
+    call = Py_BuildValue("(OddOO)", lefts, t, max_interval, next_lefts, left_plays);
+    if (!call) goto done;
+    l_parts = hand_parts(NULL, call);
+    Py_CLEAR(call);
+    if (!l_parts || l_parts == Py_None) {
+        if (l_parts == Py_None) result = l_parts, l_parts = NULL;
+        goto done;
+    }
+    /* the parts each played option makes, then its step */
+    Py_ssize_t made_n = n_played;
+    long long *m_row = malloc(sizeof(long long) * (size_t)(3 * made_n + 1));
+    if (!m_row) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    long long *m_r = m_row + made_n, *m_l = m_r + made_n;
+    for (Py_ssize_t j = 0; j < n_played; j++) {
+        PyObject *op = PyTuple_GET_ITEM(played, j);
+        PyObject *r_piece = PyTuple_GET_ITEM(op, 1), *l_piece = PyTuple_GET_ITEM(op, 5);
+        m_r[j] = m_l[j] = -1;
+        PyObject *num;
+        if (r_piece != Py_None) {
+            num = made_part(next_rights, t, PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(op, 2)),
+                            max_interval, r_piece);
+            if (!num) goto made_fail;
+            m_r[j] = PyLong_AsLongLong(num);
+            Py_DECREF(num);
+        }
+        if (l_piece != Py_None) {
+            num = made_part(next_lefts, t, PyFloat_AS_DOUBLE(PyTuple_GET_ITEM(op, 6)),
+                            max_interval, l_piece);
+            if (!num) goto made_fail;
+            m_l[j] = PyLong_AsLongLong(num);
+            Py_DECREF(num);
+        }
+        PyObject *key = PyTuple_Pack(2, PyTuple_GET_ITEM(op, 9), t_o);
+        if (!key) goto made_fail;
+        num = number_of(next_rows, key);
+        Py_DECREF(key);
+        if (!num) goto made_fail;
+        m_row[j] = PyLong_AsLongLong(num);
+        Py_DECREF(num);
+    }
+    long long n_rights = PyDict_GET_SIZE(next_rights), n_lefts = PyDict_GET_SIZE(next_lefts);
+    long long n_rl = n_rights * n_lefts;
+    steps = PyList_New(n_played);
+    if (!steps) goto made_fail;
+    for (Py_ssize_t j = 0; j < n_played; j++) {
+        PyObject *op = PyTuple_GET_ITEM(played, j);
+        long long base = m_row[j] * n_rl + (m_r[j] > 0 ? m_r[j] : 0) * n_lefts +
+                         (m_l[j] > 0 ? m_l[j] : 0);
+        long long keeps = (m_r[j] < 0) + 2 * (m_l[j] < 0);
+        PyObject *st = Py_BuildValue("(OOOOLL)", PyTuple_GET_ITEM(op, 0),
+                                     PyTuple_GET_ITEM(pens, j), PyTuple_GET_ITEM(op, 11),
+                                     PyTuple_GET_ITEM(op, 12), base, keeps);
+        if (!st) goto made_fail;
+        PyList_SET_ITEM(steps, j, st);
+    }
+    free(m_row);
+    m_row = NULL;
+    long long cur_lefts = PyList_GET_SIZE(lefts);
+    long long cur_rl = PyList_GET_SIZE(rights) * cur_lefts;
+    call = Py_BuildValue("(OOLLOOOOOOOLLLLO)", keys, accs, cur_rl, cur_lefts, row_costs,
+                         row_kept, PyTuple_GET_ITEM(r_parts, 0), PyTuple_GET_ITEM(r_parts, 1),
+                         PyTuple_GET_ITEM(l_parts, 0), PyTuple_GET_ITEM(l_parts, 1), steps,
+                         n_rl, n_lefts, (long long)PyDict_GET_SIZE(next_rows), drop_k,
+                         drop_pen_o);
+    if (!call) goto done;
+    merged = hand_layer(NULL, call);
+    Py_CLEAR(call);
+    if (!merged || merged == Py_None) {
+        if (merged == Py_None) result = merged, merged = NULL;
+        goto done;
+    }
+    {
+        PyObject *kr = PyDict_Keys(next_rows), *krt = PyDict_Keys(next_rights);
+        PyObject *klt = PyDict_Keys(next_lefts);
+        if (kr && krt && klt)
+            result = PyTuple_Pack(6, kr, krt, klt, PyTuple_GET_ITEM(merged, 0),
+                                  PyTuple_GET_ITEM(merged, 1), PyTuple_GET_ITEM(merged, 2));
+        Py_XDECREF(kr);
+        Py_XDECREF(krt);
+        Py_XDECREF(klt);
+    }
+    goto done;
+made_fail:
+    free(m_row);
+done:
+    Py_XDECREF(next_rows);
+    Py_XDECREF(next_rights);
+    Py_XDECREF(next_lefts);
+    Py_XDECREF(row_costs);
+    Py_XDECREF(row_kept);
+    Py_XDECREF(r_parts);
+    Py_XDECREF(l_parts);
+    Py_XDECREF(steps);
+    Py_XDECREF(merged);
+    Py_XDECREF(none_key);
+    Py_XDECREF(call);
+    return result;
+}
+
 /* ------------------------------------------------------------ bass_solve */
 
 /* A bass state (string, fret, hand position) coded as one integer; -1: None. */
@@ -719,6 +936,7 @@ done:
 static PyMethodDef methods[] = {
     {"hand_layer", hand_layer, METH_VARARGS, "One layer of the hand DP (virja.plan.drums)."},
     {"hand_parts", hand_parts, METH_VARARGS, "One hand's parts of a layer (virja.plan.drums)."},
+    {"hand_step", hand_step, METH_VARARGS, "One group of the hand DP (virja.plan.drums)."},
     {"bass_solve", bass_solve, METH_VARARGS, "The bass DP (virja.plan.bass.solve)."},
     {NULL, NULL, 0, NULL},
 };

@@ -547,6 +547,110 @@ def _merge_layer(
     return list(reached), list(reached.values()), list(came.values())
 
 
+def _step(
+    layer: _Layer,
+    accs: list[float],
+    t: float,
+    comp: _Compiled,
+    max_interval: float,
+    rest_s: float,
+    table: tuple[tuple[float, ...], ...],
+    none_row: tuple[float, ...],
+    drop_k: int,
+    drop_pen: float,
+) -> tuple[list[_Row], list[_Sub], list[_Sub], list[int], list[float], list[int]]:
+    """One group of :func:`solve` (the beam aside): the next layer's rows, right and left
+    hands' parts, state keys, least objectives and back-pointers.  ``_dpcore.c``'s
+    ``hand_step`` is this compiled."""
+    next_rows: dict[tuple[object, object], int] = {}
+    next_rights: dict[tuple[object, object], int] = {}
+    next_lefts: dict[tuple[object, object], int] = {}
+    # per row of this layer: the table row its first played motion pays, and the
+    # row kept when every stroke is dropped
+    row_costs: list[tuple[float, ...]] = []
+    row_kept: list[int] = []
+    for prev, prev_t in layer.rows:
+        if prev_t is not None and t - prev_t >= rest_s:
+            row_costs.append(none_row)
+            row_kept.append(next_rows.setdefault((None, None), len(next_rows)))
+        else:
+            recent = prev_t is not None
+            row_costs.append(table[prev] if prev is not None and recent else none_row)
+            row_kept.append(next_rows.setdefault((prev, prev_t), len(next_rows)))
+    right_kept, right_class = _hand_parts(
+        layer.rights, t, max_interval, next_rights, comp.right_plays
+    )
+    left_kept, left_class = _hand_parts(layer.lefts, t, max_interval, next_lefts, comp.left_plays)
+    # the parts each played option makes
+    made: list[tuple[int, int, int]] = []
+    for _k, r_piece, r_dt, _rn, _rr, l_piece, l_dt, _ln, _lr, last, *_ in comp.played:
+        nr = -1
+        if r_piece is not None:
+            tr = None if t - (t + r_dt) >= max_interval else t + r_dt
+            nr = next_rights.setdefault((tr, None if tr is None else r_piece), len(next_rights))
+        nl = -1
+        if l_piece is not None:
+            tl = None if t - (t + l_dt) >= max_interval else t + l_dt
+            nl = next_lefts.setdefault((tl, None if tl is None else l_piece), len(next_lefts))
+        made.append((next_rows.setdefault((last, t), len(next_rows)), nr, nl))
+    n_rights, n_lefts = len(next_rights), len(next_lefts)
+    n_rl = n_rights * n_lefts
+    steps: list[_Step] = []
+    for played, pens, (nrow, nr, nl) in zip(comp.played, comp.pens, made, strict=True):
+        k, first, pair = played[0], played[11], played[12]
+        base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
+        steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
+    cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
+    merged = None
+    core = fastdp.core
+    if core is not None:  # the same loop compiled (virja/plan/_dpcore.c)
+        merged = core.hand_layer(
+            layer.keys,
+            accs,
+            cur_rl,
+            cur_lefts,
+            row_costs,
+            row_kept,
+            right_kept,
+            right_class,
+            left_kept,
+            left_class,
+            steps,
+            n_rl,
+            n_lefts,
+            len(next_rows),
+            drop_k,
+            drop_pen,
+        )
+    if merged is None:
+        merged = _merge_layer(
+            layer.keys,
+            accs,
+            cur_rl,
+            cur_lefts,
+            row_costs,
+            row_kept,
+            right_kept,
+            right_class,
+            left_kept,
+            left_class,
+            steps,
+            n_rl,
+            n_lefts,
+            drop_k,
+            drop_pen,
+        )
+    keys, nacc, codes = merged
+    return (
+        list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order
+        list(next_rights),  # type: ignore[arg-type]
+        list(next_lefts),  # type: ignore[arg-type]
+        keys,
+        nacc,
+        codes,
+    )
+
+
 def solve(
     costs: DrumCosts,
     timing: Timing,
@@ -617,89 +721,33 @@ def solve(
         compiled_all.append(comp)
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
-        played_opts = comp.played
-        next_rows: dict[tuple[object, object], int] = {}
-        next_rights: dict[tuple[object, object], int] = {}
-        next_lefts: dict[tuple[object, object], int] = {}
-        # per row of this layer: the table row its first played motion pays, and the
-        # row kept when every stroke is dropped
-        row_costs: list[tuple[float, ...]] = []
-        row_kept: list[int] = []
-        for prev, prev_t in layer.rows:
-            if prev_t is not None and t - prev_t >= rest_s:
-                row_costs.append(none_row)
-                row_kept.append(next_rows.setdefault((None, None), len(next_rows)))
-            else:
-                recent = prev_t is not None
-                row_costs.append(table[prev] if prev is not None and recent else none_row)
-                row_kept.append(next_rows.setdefault((prev, prev_t), len(next_rows)))
-        right_kept, right_class = _hand_parts(
-            layer.rights, t, max_interval, next_rights, comp.right_plays
-        )
-        left_kept, left_class = _hand_parts(
-            layer.lefts, t, max_interval, next_lefts, comp.left_plays
-        )
-        # the parts each played option makes
-        made: list[tuple[int, int, int]] = []
-        for _k, r_piece, r_dt, _rn, _rr, l_piece, l_dt, _ln, _lr, last, *_ in played_opts:
-            nr = -1
-            if r_piece is not None:
-                tr = None if t - (t + r_dt) >= max_interval else t + r_dt
-                nr = next_rights.setdefault((tr, None if tr is None else r_piece), len(next_rights))
-            nl = -1
-            if l_piece is not None:
-                tl = None if t - (t + l_dt) >= max_interval else t + l_dt
-                nl = next_lefts.setdefault((tl, None if tl is None else l_piece), len(next_lefts))
-            made.append((next_rows.setdefault((last, t), len(next_rows)), nr, nl))
-        n_rights, n_lefts = len(next_rights), len(next_lefts)
-        n_rl = n_rights * n_lefts
-        steps: list[_Step] = []
-        for played, pens, (nrow, nr, nl) in zip(played_opts, comp.pens, made, strict=True):
-            k, first, pair = played[0], played[11], played[12]
-            base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
-            steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
-        n_options = drop_k + 1
-        cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
-        merged = None
+        stepped = None
         core = fastdp.core
-        if core is not None:  # the same loop compiled (virja/plan/_dpcore.c)
-            merged = core.hand_layer(
+        if core is not None:  # the same step compiled (virja/plan/_dpcore.c)
+            stepped = core.hand_step(
+                layer.rows,
+                layer.rights,
+                layer.lefts,
                 layer.keys,
                 accs,
-                cur_rl,
-                cur_lefts,
-                row_costs,
-                row_kept,
-                right_kept,
-                right_class,
-                left_kept,
-                left_class,
-                steps,
-                n_rl,
-                n_lefts,
-                len(next_rows),
+                t,
+                max_interval,
+                rest_s,
+                table,
+                none_row,
+                comp.played,
+                comp.pens,
+                comp.right_plays,
+                comp.left_plays,
                 drop_k,
                 drop_pen,
             )
-        if merged is None:
-            merged = _merge_layer(
-                layer.keys,
-                accs,
-                cur_rl,
-                cur_lefts,
-                row_costs,
-                row_kept,
-                right_kept,
-                right_class,
-                left_kept,
-                left_class,
-                steps,
-                n_rl,
-                n_lefts,
-                drop_k,
-                drop_pen,
+        if stepped is None:
+            stepped = _step(
+                layer, accs, t, comp, max_interval, rest_s, table, none_row, drop_k, drop_pen
             )
-        keys, nacc, codes = merged
+        next_rows, next_rights, next_lefts, keys, nacc, codes = stepped
+        n_options = drop_k + 1
         if beam is not None:
             kept_ids = keep_best(nacc, beam)
             if kept_ids is not None:  # cut: the least-cost states, renumbered in order
@@ -707,9 +755,9 @@ def solve(
                 nacc = [nacc[i] for i in kept_ids]
                 codes = [codes[i] for i in kept_ids]
         layer = _Layer(
-            list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order
-            list(next_rights),  # type: ignore[arg-type]
-            list(next_lefts),  # type: ignore[arg-type]
+            next_rows,
+            next_rights,
+            next_lefts,
             keys,
             codes,
             n_options,

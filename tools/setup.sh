@@ -37,6 +37,9 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
   .venv/bin/python -m pip install -q -e '.[test,ray]'
   touch "$stamp"
 fi
+# The planner's inner loops compiled in place (virja/plan/_dpcore.c, with gcc and the
+# Python headers; without them the planner runs its Python loops, which plan the same).
+.venv/bin/python tools/build_dpcore.py || echo "setup: the planner's C loops were not built (it runs its Python loops)"
 
 # Node tools the tests run (tools/node/package.json, pinned by its package-lock.json):
 # the Khronos glTF Validator checks `virja export --gltf` output; node-rtpmidi (npm

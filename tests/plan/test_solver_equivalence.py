@@ -5,7 +5,9 @@
 layers).  The plain versions are kept here as references; on seeded random input,
 including cost tables with fractions and negative numbers (where the order of
 additions could matter), zero intervals and odd start states, every assignment,
-per-stroke cost, state and total must be identical, ties included.
+per-stroke cost, state and total must be identical, ties included.  Every test runs
+twice: with the compiled inner loops (``virja/plan/_dpcore.c``, skipped when not
+built) and with the Python loops.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ from __future__ import annotations
 import dataclasses
 import math
 import random
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
-from virja.plan import bass, drums
+import pytest
+
+from virja.plan import bass, drums, fastdp
 from virja.plan.bounds import keep_best
 from virja.plan.config import (
     BassSetup,
@@ -27,6 +31,16 @@ from virja.plan.config import (
 )
 from virja.plan.drums import RIGHT, Assignment, HandGroup, HandSolution, HandState, Stroke
 from virja.vocab import HAND_PIECES
+
+
+@pytest.fixture(autouse=True, params=["compiled", "python"])
+def loops(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Iterator[str]:
+    """The solvers' inner loops: compiled (virja.plan.fastdp.core) or Python."""
+    if request.param == "python":
+        monkeypatch.setattr(fastdp, "core", None)
+    elif fastdp.core is None:
+        pytest.skip("virja/plan/_dpcore.c is not built (python tools/build_dpcore.py)")
+    yield request.param
 
 
 def _reference_drums(

@@ -35,6 +35,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from virja.plan import fastdp
 from virja.plan.config import BassSetup, Fingering
 from virja.vocab import BassPluck, as_bass_string
 
@@ -237,6 +238,9 @@ class _Tables:
     shift_times: list[float]
     position_costs: list[float]
     prepared: dict[Sequence[BassOption], list[_Prepared]]
+    # the fingering's costs all floats: the compiled DP (which sums in floats) gives
+    # the very objects the loop gives
+    floats: bool
 
 
 _PREPARED_LIMIT = 4096  # distinct groups' options (chord_options memoises as many)
@@ -257,6 +261,15 @@ def _tables(fingering: Fingering) -> _Tables:
             [fingering.shift_time(d) for d in range(top)],
             [per * (h - 1) for h in range(top)],
             {},
+            all(
+                type(x) is float
+                for x in (
+                    per,
+                    fingering.shift_cost,
+                    fingering.shift_cost_per_fret,
+                    fingering.rushed_shift_cost,
+                )
+            ),
         )
         entry = _tables_cache = (fingering, tables)
     return entry[1]
@@ -291,13 +304,28 @@ def solve(
     Ties go to the earlier option (open strings and low frets first), then the
     lower hand position and, among end states, to the first reached.
     """
-    best: dict[BassState, float] = {state: 0.0}
-    backs: list[dict[BassState, tuple[BassState, int, float]]] = []
     shift_cost = fingering.shift_cost
     shift_per_fret = fingering.shift_cost_per_fret
     rushed = fingering.rushed_shift_cost
     tables = _tables(fingering)
     spans, shift_times, position_costs = tables.spans, tables.shift_times, tables.position_costs
+    core = fastdp.core
+    if core is not None and tables.floats:  # the same DP compiled (virja/plan/_dpcore.c)
+        found = core.bass_solve(
+            state,
+            [_prepared(tables, fingering, options) for options in groups],
+            gaps,
+            spans,
+            shift_times,
+            position_costs,
+            shift_cost,
+            shift_per_fret,
+            rushed,
+        )
+        if found is not None:  # None: input it does not take (the loop below does)
+            return BassSolution(*found)
+    best: dict[BassState, float] = {state: 0.0}
+    backs: list[dict[BassState, tuple[BassState, int, float]]] = []
     for gi, options in enumerate(groups):
         gap = math.inf if gaps is None else gaps[gi]
         prepared = _prepared(tables, fingering, options)

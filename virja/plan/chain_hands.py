@@ -88,6 +88,29 @@ def hand_group(
             chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
         )
         return HandGroupPlan(drums_mod.HandGroup(t0, (stroke,)), [[r]], [], [])
+    if len(group) == 2 and group[0].drum.piece != group[1].drum.piece:
+        # two pieces: two strokes, the more important first (what the loops below make)
+        a, b = group
+        rank_a = (velocity_priority(a.drum.priority, a.note.velocity), a.note.time_s, a.seq)
+        rank_b = (velocity_priority(b.drum.priority, b.note.velocity), b.note.time_s, b.seq)
+        pair = ((rank_a, a), (rank_b, b)) if rank_a < rank_b else ((rank_b, b), (rank_a, a))
+        return HandGroupPlan(
+            drums_mod.HandGroup(
+                t0,
+                tuple(
+                    drums_mod.Stroke(
+                        r.drum.piece,
+                        rank[0],
+                        r.note.time_s - t0,
+                        chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+                    )
+                    for rank, r in pair
+                ),
+            ),
+            [[pair[0][1]], [pair[1][1]]],
+            [],
+            [],
+        )
     clusters: list[list[DrumHeld]] = []
     for r in sorted(group, key=lambda r: (r.note.time_s, r.seq)):
         piece, t = r.drum.piece, r.note.time_s

@@ -27,6 +27,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from virja.plan import fastdp
 from virja.plan.bounds import keep_best
 from virja.plan.config import DrumCosts, Timing
 from virja.vocab import HAND_PIECES, Hand
@@ -442,7 +443,14 @@ def _hand_parts(
     forgotten it (numbered in ``next_parts`` as met), and its class per played option
     (``plays``: this hand's dt, reach and classed steps, :class:`_Compiled`): the class
     of the first step it comes sooner than (0: none, the penalty it pays numbered),
-    :data:`_INFEASIBLE` too soon."""
+    :data:`_INFEASIBLE` too soon.  ``_dpcore.c``'s ``hand_parts`` is this loop compiled."""
+    core = fastdp.core
+    if core is not None:
+        found: tuple[list[int], list[list[int]]] | None = core.hand_parts(
+            parts, t, max_interval, next_parts, plays
+        )
+        if found is not None:
+            return found
     kept: list[int] = []
     classes: list[list[int]] = []
     for last, piece in parts:
@@ -469,6 +477,178 @@ def _hand_parts(
             row.append(c)
         classes.append(row)
     return kept, classes
+
+
+def _merge_layer(
+    keys_in: list[int],
+    accs: list[float],
+    cur_rl: int,
+    cur_lefts: int,
+    row_costs: list[tuple[float, ...]],
+    row_kept: list[int],
+    right_kept: list[int],
+    right_class: list[list[int]],
+    left_kept: list[int],
+    left_class: list[list[int]],
+    steps: list[_Step],
+    n_rl: int,
+    n_lefts: int,
+    drop_k: int,
+    drop_pen: float,
+) -> tuple[list[int], list[float], list[int]]:
+    """One layer of :func:`solve`: every state of the layer (``keys_in``, ``accs``) with
+    every played option (``steps``) and then the option that drops every stroke, merged
+    into the next layer's states in first-reached order; returns their keys, least
+    objectives and back-pointers (``state * n_options + option``).  ``_dpcore.c``'s
+    ``hand_layer`` is this loop compiled."""
+    # the next layer, by state key in first-reached order (a dictionary keeps the
+    # order of insertion): least objective, and where it came from as
+    # ``state * n_options + option``
+    reached: dict[int, float] = {}
+    came: dict[int, int] = {}
+    n_options = drop_k + 1
+    inf = math.inf
+    get = reached.get
+    for sid, (key, acc) in enumerate(zip(keys_in, accs, strict=True)):
+        ri, hands = divmod(key, cur_rl)
+        rh, lh = divmod(hands, cur_lefts)
+        row = row_costs[ri]
+        keep_r = right_kept[rh] * n_lefts
+        keep_l = left_kept[lh]
+        # what a step adds to its base key: the hands it leaves as they were
+        kept_keys = (0, keep_r, keep_l, keep_r + keep_l)
+        here = sid * n_options
+        for (k, pens, first, pair, base, keeps), rc, lc in zip(
+            steps, right_class[rh], left_class[lh], strict=True
+        ):
+            c = rc + lc
+            if c < 0:
+                continue
+            key = base + kept_keys[keeps]
+            total = acc + pens[c] + row[first] + pair
+            old = get(key)
+            if old is None:  # reached first: numbered now (as inf, then merged)
+                reached[key] = total
+                came[key] = here + k if total < inf else 0
+            elif total < old:
+                reached[key] = total
+                came[key] = here + k
+        # dropping every stroke: the row and hands as kept
+        key = row_kept[ri] * n_rl + kept_keys[3]
+        total = acc + drop_pen
+        old = get(key)
+        if old is None:
+            reached[key] = total
+            came[key] = here + drop_k if total < inf else 0
+        elif total < old:
+            reached[key] = total
+            came[key] = here + drop_k
+    # the same order: both keyed when first reached
+    return list(reached), list(reached.values()), list(came.values())
+
+
+def _step(
+    layer: _Layer,
+    accs: list[float],
+    t: float,
+    comp: _Compiled,
+    max_interval: float,
+    rest_s: float,
+    table: tuple[tuple[float, ...], ...],
+    none_row: tuple[float, ...],
+    drop_k: int,
+    drop_pen: float,
+) -> tuple[list[_Row], list[_Sub], list[_Sub], list[int], list[float], list[int]]:
+    """One group of :func:`solve` (the beam aside): the next layer's rows, right and left
+    hands' parts, state keys, least objectives and back-pointers.  ``_dpcore.c``'s
+    ``hand_step`` is this compiled."""
+    next_rows: dict[tuple[object, object], int] = {}
+    next_rights: dict[tuple[object, object], int] = {}
+    next_lefts: dict[tuple[object, object], int] = {}
+    # per row of this layer: the table row its first played motion pays, and the
+    # row kept when every stroke is dropped
+    row_costs: list[tuple[float, ...]] = []
+    row_kept: list[int] = []
+    for prev, prev_t in layer.rows:
+        if prev_t is not None and t - prev_t >= rest_s:
+            row_costs.append(none_row)
+            row_kept.append(next_rows.setdefault((None, None), len(next_rows)))
+        else:
+            recent = prev_t is not None
+            row_costs.append(table[prev] if prev is not None and recent else none_row)
+            row_kept.append(next_rows.setdefault((prev, prev_t), len(next_rows)))
+    right_kept, right_class = _hand_parts(
+        layer.rights, t, max_interval, next_rights, comp.right_plays
+    )
+    left_kept, left_class = _hand_parts(layer.lefts, t, max_interval, next_lefts, comp.left_plays)
+    # the parts each played option makes
+    made: list[tuple[int, int, int]] = []
+    for _k, r_piece, r_dt, _rn, _rr, l_piece, l_dt, _ln, _lr, last, *_ in comp.played:
+        nr = -1
+        if r_piece is not None:
+            tr = None if t - (t + r_dt) >= max_interval else t + r_dt
+            nr = next_rights.setdefault((tr, None if tr is None else r_piece), len(next_rights))
+        nl = -1
+        if l_piece is not None:
+            tl = None if t - (t + l_dt) >= max_interval else t + l_dt
+            nl = next_lefts.setdefault((tl, None if tl is None else l_piece), len(next_lefts))
+        made.append((next_rows.setdefault((last, t), len(next_rows)), nr, nl))
+    n_rights, n_lefts = len(next_rights), len(next_lefts)
+    n_rl = n_rights * n_lefts
+    steps: list[_Step] = []
+    for played, pens, (nrow, nr, nl) in zip(comp.played, comp.pens, made, strict=True):
+        k, first, pair = played[0], played[11], played[12]
+        base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
+        steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
+    cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
+    merged = None
+    core = fastdp.core
+    if core is not None:  # the same loop compiled (virja/plan/_dpcore.c)
+        merged = core.hand_layer(
+            layer.keys,
+            accs,
+            cur_rl,
+            cur_lefts,
+            row_costs,
+            row_kept,
+            right_kept,
+            right_class,
+            left_kept,
+            left_class,
+            steps,
+            n_rl,
+            n_lefts,
+            len(next_rows),
+            drop_k,
+            drop_pen,
+        )
+    if merged is None:
+        merged = _merge_layer(
+            layer.keys,
+            accs,
+            cur_rl,
+            cur_lefts,
+            row_costs,
+            row_kept,
+            right_kept,
+            right_class,
+            left_kept,
+            left_class,
+            steps,
+            n_rl,
+            n_lefts,
+            drop_k,
+            drop_pen,
+        )
+    keys, nacc, codes = merged
+    return (
+        list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order
+        list(next_rights),  # type: ignore[arg-type]
+        list(next_lefts),  # type: ignore[arg-type]
+        keys,
+        nacc,
+        codes,
+    )
 
 
 def solve(
@@ -527,7 +707,6 @@ def solve(
     rest_s = timing.rest_s
     table = costs.table
     none_row = table[costs.none_row]
-    inf = math.inf
     prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
     start = _Layer([(prev0, prev_t0)], [(t_right0, p_right0)], [(t_left0, p_left0)], [0], [0], 1)
     layer = start
@@ -542,92 +721,33 @@ def solve(
         compiled_all.append(comp)
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
-        played_opts = comp.played
-        next_rows: dict[tuple[object, object], int] = {}
-        next_rights: dict[tuple[object, object], int] = {}
-        next_lefts: dict[tuple[object, object], int] = {}
-        # per row of this layer: the table row its first played motion pays, and the
-        # row kept when every stroke is dropped
-        row_costs: list[tuple[float, ...]] = []
-        row_kept: list[int] = []
-        for prev, prev_t in layer.rows:
-            if prev_t is not None and t - prev_t >= rest_s:
-                row_costs.append(none_row)
-                row_kept.append(next_rows.setdefault((None, None), len(next_rows)))
-            else:
-                recent = prev_t is not None
-                row_costs.append(table[prev] if prev is not None and recent else none_row)
-                row_kept.append(next_rows.setdefault((prev, prev_t), len(next_rows)))
-        right_kept, right_class = _hand_parts(
-            layer.rights, t, max_interval, next_rights, comp.right_plays
-        )
-        left_kept, left_class = _hand_parts(
-            layer.lefts, t, max_interval, next_lefts, comp.left_plays
-        )
-        # the parts each played option makes
-        made: list[tuple[int, int, int]] = []
-        for _k, r_piece, r_dt, _rn, _rr, l_piece, l_dt, _ln, _lr, last, *_ in played_opts:
-            nr = -1
-            if r_piece is not None:
-                tr = None if t - (t + r_dt) >= max_interval else t + r_dt
-                nr = next_rights.setdefault((tr, None if tr is None else r_piece), len(next_rights))
-            nl = -1
-            if l_piece is not None:
-                tl = None if t - (t + l_dt) >= max_interval else t + l_dt
-                nl = next_lefts.setdefault((tl, None if tl is None else l_piece), len(next_lefts))
-            made.append((next_rows.setdefault((last, t), len(next_rows)), nr, nl))
-        n_rights, n_lefts = len(next_rights), len(next_lefts)
-        n_rl = n_rights * n_lefts
-        steps: list[_Step] = []
-        for played, pens, (nrow, nr, nl) in zip(played_opts, comp.pens, made, strict=True):
-            k, first, pair = played[0], played[11], played[12]
-            base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
-            steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
-        # the next layer, by state key in first-reached order (a dictionary keeps the
-        # order of insertion): least objective, and where it came from as
-        # ``state * n_options + option``
-        reached: dict[int, float] = {}
-        came: dict[int, int] = {}
+        stepped = None
+        core = fastdp.core
+        if core is not None:  # the same step compiled (virja/plan/_dpcore.c)
+            stepped = core.hand_step(
+                layer.rows,
+                layer.rights,
+                layer.lefts,
+                layer.keys,
+                accs,
+                t,
+                max_interval,
+                rest_s,
+                table,
+                none_row,
+                comp.played,
+                comp.pens,
+                comp.right_plays,
+                comp.left_plays,
+                drop_k,
+                drop_pen,
+            )
+        if stepped is None:
+            stepped = _step(
+                layer, accs, t, comp, max_interval, rest_s, table, none_row, drop_k, drop_pen
+            )
+        next_rows, next_rights, next_lefts, keys, nacc, codes = stepped
         n_options = drop_k + 1
-        get = reached.get
-        cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
-        for sid, (key, acc) in enumerate(zip(layer.keys, accs, strict=True)):
-            ri, hands = divmod(key, cur_rl)
-            rh, lh = divmod(hands, cur_lefts)
-            row = row_costs[ri]
-            keep_r = right_kept[rh] * n_lefts
-            keep_l = left_kept[lh]
-            # what a step adds to its base key: the hands it leaves as they were
-            kept_keys = (0, keep_r, keep_l, keep_r + keep_l)
-            here = sid * n_options
-            for (k, pens, first, pair, base, keeps), rc, lc in zip(
-                steps, right_class[rh], left_class[lh], strict=True
-            ):
-                c = rc + lc
-                if c < 0:
-                    continue
-                key = base + kept_keys[keeps]
-                total = acc + pens[c] + row[first] + pair
-                old = get(key)
-                if old is None:  # reached first: numbered now (as inf, then merged)
-                    reached[key] = total
-                    came[key] = here + k if total < inf else 0
-                elif total < old:
-                    reached[key] = total
-                    came[key] = here + k
-            # dropping every stroke: the row and hands as kept
-            key = row_kept[ri] * n_rl + kept_keys[3]
-            total = acc + drop_pen
-            old = get(key)
-            if old is None:
-                reached[key] = total
-                came[key] = here + drop_k if total < inf else 0
-            elif total < old:
-                reached[key] = total
-                came[key] = here + drop_k
-        keys = list(reached)
-        nacc = list(reached.values())
-        codes = list(came.values())  # same order: both keyed when first reached
         if beam is not None:
             kept_ids = keep_best(nacc, beam)
             if kept_ids is not None:  # cut: the least-cost states, renumbered in order
@@ -635,9 +755,9 @@ def solve(
                 nacc = [nacc[i] for i in kept_ids]
                 codes = [codes[i] for i in kept_ids]
         layer = _Layer(
-            list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order
-            list(next_rights),  # type: ignore[arg-type]
-            list(next_lefts),  # type: ignore[arg-type]
+            next_rows,
+            next_rights,
+            next_lefts,
             keys,
             codes,
             n_options,

@@ -42,11 +42,41 @@ def align(
     the full anticipation (``known_s > time - anticipation``): compressed, it
     starts at ``known_s`` and strikes at ``max(time, known_s + min_anticipation)``.
     """
-    a = anticipation_s(timing, kind, seconds_per_beat)
+    a, shortest, allowed = _offsets(timing, kind, seconds_per_beat)
     start = time_s - a
     if known_s <= start:
-        return Alignment(start, time_s, False)
-    shortest = timing.get(kind).min_anticipation_s
+        return _new(Alignment, (start, time_s, False))
     impact = max(time_s, known_s + shortest)
-    allowed = shortest if timing.immediate else 0.0  # played at once: the stroke is the norm
-    return Alignment(known_s, impact, impact > time_s + allowed + LATE_EPS_S)
+    return _new(Alignment, (known_s, impact, impact > time_s + allowed + LATE_EPS_S))
+
+
+# made as the named tuple's own constructor makes it, without its Python-level frame
+# (align runs for every note the planner takes in)
+_new = tuple.__new__
+
+
+# per (kind, seconds per beat): the anticipation, the shortest one and the lateness
+# allowed, for the last timing used (matched by identity, as virja.plan.drums keeps its
+# compiled options; a timing is never changed); reading the global once makes it safe
+# across threads
+_OFFSETS_LIMIT = 4096  # a session has a few kinds at a few tempi
+_offsets_cache: tuple[Timing, dict[tuple[str, float], tuple[float, float, float]]] | None = None
+
+
+def _offsets(timing: Timing, kind: str, seconds_per_beat: float) -> tuple[float, float, float]:
+    """:func:`anticipation_s`, ``min_anticipation_s`` and what :func:`align` allows a
+    note played at once (the shortest stroke, else 0), worked out once per kind and tempo."""
+    global _offsets_cache
+    entry = _offsets_cache
+    if entry is None or entry[0] is not timing:
+        entry = _offsets_cache = (timing, {})
+    key = (kind, seconds_per_beat)
+    found = entry[1].get(key)
+    if found is None:
+        if len(entry[1]) >= _OFFSETS_LIMIT:
+            entry[1].clear()
+        shortest = timing.get(kind).min_anticipation_s
+        # played at once: the stroke is the norm
+        allowed = shortest if timing.immediate else 0.0
+        found = entry[1][key] = (anticipation_s(timing, kind, seconds_per_beat), shortest, allowed)
+    return found

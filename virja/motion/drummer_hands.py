@@ -14,8 +14,11 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   time is short); after ``rest_after_s`` without a stroke it goes to the
   relaxed ready pose and comes back in time for the next.  A move the plan
   leaves less time than that goes at even speed between short ramps
-  (``_SQUEEZED``); a hand over a cymbal that the other hand strikes next gets
-  out of its way to the ready pose (:meth:`DrummerHands._yield`).
+  (``_SQUEEZED``), and the stick takes part of it: at the impacts on either side
+  the hand and stick are turned about the tip so the wrist sits toward the other
+  piece (``reach_*``, :meth:`DrummerHands._reached`; not where the hands cross);
+  a hand over a cymbal (or on the spot of a drum) that the other hand strikes
+  next gets out of its way low and sideways (:meth:`DrummerHands._yield`).
 - **lift**: velocity sets the stick tip's height above the surface (not a
   scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity
   (to the power ``lift_curve``; a side-stick at most ``side_stick_m``, a rim
@@ -67,13 +70,31 @@ _MOVE_OFF_HIHAT, _HIHAT_LAG = 5, 2.5
 # as soon as that stroke is known, if it has at least _YIELD_MIN_S before it: sticks
 # passed through each other as the hands swapped over a cymbal (GMD rock-prog 190)
 _YIELDING = frozenset(CYMBAL_PIECES)
-_YIELD_MIN_S = 0.08
-_YIELD_AFTER_S = 0.05  # after its own impact: the stick leaves the cymbal at once
+_YIELD_MIN_S = 0.05
+_YIELD_AFTER_S = 0.04  # after its own impact: the stick leaves the cymbal at once
+# ... low and sideways, not back to the ready pose: the way back crossed the incoming
+# stick when the other hand came in 85 ms later (GMD rock-prog 190 at 11.68 s); the grip
+# moves this far (m) away from the other stick's strike point, the tip this low over the
+# piece, in at most _YIELD_MOVE_S.  On a drum only when the two tips land this near
+# (m): hands alternate on the snare each on its own spot, but the right came down on
+# the high tom where the left had just struck (rock-prog 190 at 10.43 s)
+_YIELD_ASIDE_M, _YIELD_LOW_M, _YIELD_MOVE_S = 0.12, 0.03, 0.15
+_YIELD_NEAR_M = 0.12
+_YIELD_SHARE = 0.6  # out of the way within this share of the time to the other's impact
 # a move the plan squeezes (no time to hover first): constant speed between two short
 # ramps of this share each, so the peak speed is 1 / (1 - _RAMP) of the average (1.25;
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
 _SQUEEZED, _RAMP = 4, 0.2
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
+# a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
+# stroke is known at least this long before the impact
+_REACH_MIN_S = 0.04
+_CROSSED_S = 0.25  # see DrummerHands._crossed
+_REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
+# a move with time to spare takes up to this many times its time at move_speed_m_s (the
+# hand leaves sooner and goes slower): its smoothstep peak and a downstroke at its end
+# added up to 15-16 cm a frame at 30 fps (GMD rock-prog 190 at 11.94 s, rock 180 at 7.3 s)
+_EARLY = 1.0
 
 
 @dataclass(frozen=True)
@@ -97,6 +118,8 @@ class HandSettings:
     move_speed_m_s: float = 2.0
     rest_after_s: float = 2.0
     rest_move_s: float = 0.5
+    reach_speed_m_s: float = 2.5
+    reach_max_m: float = 0.12
 
     @classmethod
     def clips(cls) -> HandSettings:
@@ -159,6 +182,11 @@ class _Base:
     lv: list[float]
     lp: list[Any]
     last: tuple[float, float, np.ndarray, str | None] | None
+
+
+def _tip(row: np.ndarray) -> np.ndarray:
+    """The stick's tip of a (grip, rot, ...) row."""
+    return np.asarray(row[:3] + STICK_TIP_M * quat.rotate(row[3:7], STICK_AXIS_LOCAL))
 
 
 def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
@@ -490,12 +518,14 @@ class DrummerHands:
         return float(min(by_vel, s.lift_per_s * gap))
 
     def _yield(
-        self, hand: str, t: float, piece: str | None, next_t: float
-    ) -> tuple[float, float] | None:
-        """(when ``hand`` starts to get out of the way, the other hand's impact) when the
-        other hand strikes the cymbal ``hand`` struck at ``t`` before ``hand`` strikes
-        again at ``next_t``; from when that stroke is known, after the rebound."""
-        if piece not in _YIELDING:
+        self, hand: str, t: float, piece: str | None, next_t: float, row: np.ndarray
+    ) -> tuple[float, float, tuple[np.ndarray, np.ndarray]] | None:
+        """(when ``hand`` starts to get out of the way, the other hand's impact, the other
+        stick's tip and grip there) when the other hand strikes the piece ``hand`` struck at
+        ``t`` (in pose ``row``) before ``hand`` strikes again at ``next_t``: any cymbal,
+        a drum when the two tips land within ``_YIELD_NEAR_M``; from when that stroke
+        is known, after the rebound."""
+        if piece is None:
             return None
         other = HANDS[1 - HANDS.index(hand)]
         times = self._times[other]
@@ -506,12 +536,87 @@ class DrummerHands:
             start_o, pose_o, _v, _a = self._strokes[other][j]
             if pose_o.piece != piece:
                 continue
+            tip_o = _tip(np.concatenate([pose_o.grip, pose_o.rot]))
+            if piece not in _YIELDING and np.linalg.norm(tip_o - _tip(row)) > _YIELD_NEAR_M:
+                return None  # alternating on a drum, each on its own spot
             cut = max(start_o, t + _YIELD_AFTER_S)
             if cut >= t + 0.5 * self.settings.rest_after_s:
                 return None  # going to rest anyway
             # no time to get out of the way: stay rather than cross the incoming stick
-            return (cut, t_o) if t_o - cut >= _YIELD_MIN_S else None
+            out = (cut, t_o, (tip_o, pose_o.grip))
+            return out if t_o - cut >= _YIELD_MIN_S else None
         return None
+
+    def _wrist(self, hand: str, row: np.ndarray) -> np.ndarray:
+        """The wrist of a (grip, rot, elbow) row."""
+        return np.asarray(row[:3] - quat.rotate(row[3:7], self._grip_off[hand]))
+
+    def _reach(self, hand: str, row: np.ndarray, toward: np.ndarray, dist: float) -> np.ndarray:
+        """``row`` with the hand and stick turned about the stick's tip so that the wrist
+        sits up to ``dist`` nearer ``toward`` (a wrist position; the part of the way
+        square to the stick, which is all a turn about the tip can give): the tip stays
+        exactly where it was, the stick takes part of a far move (:meth:`_reached`)."""
+        grip, rot = row[:3], row[3:7]
+        tip = _tip(row)
+        r = self._wrist(hand, row) - tip
+        lever = float(np.linalg.norm(r))
+        way = toward - (tip + r)
+        r_hat = r / lever
+        way = way - float(way @ r_hat) * r_hat
+        norm = float(np.linalg.norm(way))
+        if dist <= 1e-4 or norm < 1e-6:
+            return row
+        axis = np.cross(r_hat, way / norm)
+        axis = axis / np.linalg.norm(axis)
+        theta = math.asin(min(dist, norm, 0.9 * lever) / lever)
+        # never nearer full stretch than _REACH_SLACK_M (nor than the clip's own pose):
+        # the body's turn moves the shoulder, and an arm out of reach misses the piece
+        shoulder = self._shoulder[hand]
+        full = self._l1[hand] + self._l2[hand] - _REACH_SLACK_M
+        limit = max(full, float(np.linalg.norm(tip + r - shoulder)))
+        for _ in range(6):
+            q = quat.from_axis_angle(axis, theta)
+            if float(np.linalg.norm(tip + quat.rotate(q, r) - shoulder)) <= limit:
+                break
+            theta *= 0.5
+        else:
+            return row
+        out = row.copy()
+        out[:3] = tip + quat.rotate(q, grip - tip)
+        out[3:7] = quat.multiply(q, rot)
+        return out
+
+    def _reached(
+        self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float, t: float
+    ) -> np.ndarray:
+        """``row`` reaching toward ``here`` (a row) when the wrist's way between them in
+        ``span`` s is longer than ``reach_speed_m_s`` allows: by ``share`` of the excess,
+        at most ``reach_max_m``."""
+        s = self.settings
+        a, b = self._wrist(hand, row), self._wrist(hand, here)
+        excess = float(np.linalg.norm(a - b)) - s.reach_speed_m_s * max(span, 0.0)
+        if excess <= 0.0 or self._crossed(hand, row, t):
+            return row
+        return self._reach(hand, row, b, min(share * excess, s.reach_max_m))
+
+    def _crossed(self, hand: str, row: np.ndarray, t: float) -> bool:
+        """Whether the other hand strikes on ``hand``'s side of ``row``'s tip within
+        ``_CROSSED_S`` of ``t`` (the hands cross, as a left hand on the ride while the
+        right plays the snare), or within 25 cm of it (both on the ride): there a stick turned about its tip swept through the
+        other stick (MMA Swing1 at 300 bpm: 5 -> 7 runs), so the wrist goes the whole way."""
+        other = HANDS[1 - HANDS.index(hand)]
+        side = self._shoulder[hand] - self._shoulder[other]
+        side[1] = 0.0
+        times = self._times[other]
+        lo = bisect.bisect_left(times, t - _CROSSED_S)
+        hi = bisect.bisect_right(times, t + _CROSSED_S)
+        tip = _tip(row)
+        for k in range(lo, hi):
+            pose = self._strokes[other][k][1]
+            tip_o = _tip(np.concatenate([pose.grip, pose.rot]))
+            if float((tip_o - tip) @ side) > 0.0 or np.linalg.norm(tip_o - tip) < 0.25:
+                return True  # crossed, or both on one piece
+        return False
 
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
@@ -536,18 +641,31 @@ class DrummerHands:
         times = self._times[hand]
         home = np.concatenate([rest.grip, rest.rot, rest.elbow])
 
-        def get_out_of_the_way(t: float, piece: str | None, nxt: float) -> None:
-            """After the stroke at ``t`` on ``piece``, to the ready pose if the other
-            hand strikes that cymbal before ``nxt`` (:meth:`_yield`)."""
-            yielding = self._yield(hand, t, piece, nxt)
+        def get_out_of_the_way(t: float, piece: str | None, nxt: float, row: np.ndarray) -> None:
+            """After the stroke at ``t`` on ``piece`` (pose ``row``), low and sideways,
+            square to the other stick at its impact, to this hand's side of it, if the other hand strikes there before
+            ``nxt`` (:meth:`_yield`)."""
+            yielding = self._yield(hand, t, piece, nxt, row)
             if yielding is None or max(yielding[0], floor) >= yielding[1]:
                 return
-            at, t_o = max(yielding[0], floor), yielding[1]  # never before what is frozen
-            _cut(pt, pv, pp, at, _pose_at)
+            at, t_o, (tip_o, grip_o) = max(yielding[0], floor), yielding[1], yielding[2]
+            here = _cut(pt, pv, pp, at, _pose_at)  # never before what is frozen
             _cut(lt, lv, lp, at, _lift_at)
-            clear = at + min(s.rest_move_s, t_o - at)
-            _add(pt, pv, pp, clear, home, _SQUEEZED)
-            _add(lt, lv, lp, clear, 0.0, _SMOOTH)
+            # square to the incoming stick, to the side of it where this hand's wrist is
+            way = grip_o - tip_o
+            side = np.cross(way, _UP)
+            side[1] = 0.0
+            if float(np.linalg.norm(side)) < 1e-6:
+                side = self._shoulder[hand] - self._shoulder[HANDS[1 - HANDS.index(hand)]]
+                side[1] = 0.0
+            side = side / float(np.linalg.norm(side))
+            if float(side @ (self._wrist(hand, here) - tip_o)) < 0.0:
+                side = -side
+            aside = here.copy()
+            aside[:3] += _YIELD_ASIDE_M * side
+            clear = at + min(_YIELD_MOVE_S, _YIELD_SHARE * (t_o - at))
+            _add(pt, pv, pp, clear, aside, _SQUEEZED)
+            _add(lt, lv, lp, clear, min(s.hover_m, _YIELD_LOW_M), _SMOOTH)
 
         if base is not None:  # frozen up to a frame drawn: build on from there
             floor = base.t
@@ -558,10 +676,9 @@ class DrummerHands:
                 landed.append(base.last)
                 prev_t, prev_lift, prev_piece = base.last[0], base.last[1], base.last[3]
                 nxt = next((u for u in times if u > floor), math.inf)
-                get_out_of_the_way(prev_t, prev_piece, nxt)
-        for i, (t, (start, pose, vel, art)) in enumerate(
-            zip(times, self._strokes[hand], strict=True)
-        ):
+                get_out_of_the_way(prev_t, prev_piece, nxt, base.last[2])
+        strokes = self._strokes[hand]
+        for i, (t, (start, pose, vel, art)) in enumerate(zip(times, strokes, strict=True)):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
             target = np.concatenate([pose.grip, pose.rot, pose.elbow])
@@ -580,13 +697,30 @@ class DrummerHands:
                 lift_here = float(_cut(lt, lv, lp, cut, _lift_at))
             lift = self._lift_for(vel, gap, art)
             room = t - cut
+            # a far move with little time: the stick takes part of it (_reached); at this
+            # impact the wrist still sits toward where it comes from ...
+            target = self._reached(hand, target, here, room, 1.0, t)
+            # ... and already toward the next piece, when that stroke is known in time
+            # and its move will be short of time too: from the start when it is known
+            # before this move begins, else re-aimed from when it is known
+            j = next((k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6), None)
+            reached = target
+            if j is not None and strokes[j][0] < t - _REACH_MIN_S:
+                nxt_pose = strokes[j][1]
+                nxt_row = np.concatenate([nxt_pose.grip, nxt_pose.rot, nxt_pose.elbow])
+                reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5, t)
             down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
             down = min(down, 0.5 * room) if room > 0 else 0.0
             rise = min(2 * down + 0.05, 0.5 * gap)
-            travel = float(np.linalg.norm(target[:3] - here[:3])) / s.move_speed_m_s
+            way = max(np.linalg.norm(target[:3] - here[:3]), np.linalg.norm(reached[:3] - here[:3]))
+            travel = float(way) / s.move_speed_m_s
             if prev_t is None and base is None:
                 travel = max(travel, s.rest_move_s)
             leave = t - travel  # hover where the hand is; leave only when the move must start
+            if leave > cut + 1e-4:  # ... or a little before: a slower move, when there is time
+                leave = max(t - _EARLY * travel, cut + 1e-4)
+            if j is not None and strokes[j][0] <= max(leave, cut):
+                target = reached  # known before the hand leaves: the whole way to it
             if leave > cut + 1e-4:
                 _add(pt, pv, pp, leave, here, _SMOOTH)
                 # time enough: over the cymbals' edges
@@ -594,6 +728,11 @@ class DrummerHands:
                 _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
                 _add(pt, pv, pp, t, target, _SQUEEZED)
+            if reached is not target:  # known on the way: re-aimed from then
+                assert j is not None
+                _cut(pt, pv, pp, strokes[j][0], _pose_at)
+                _add(pt, pv, pp, t, reached, _SQUEEZED)
+                target = reached
             rebound = -math.inf  # when the last stroke's rebound is over
             if prev_t is not None:
                 rebound = prev_t + min(s.rebound_max_s, s.rebound_share * gap)
@@ -620,7 +759,7 @@ class DrummerHands:
             home = np.concatenate([rest.grip, rest.rot, rest.elbow])
             _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
             nxt = next((u for u in times[i + 1 :] if u - t >= 1e-6), math.inf)
-            get_out_of_the_way(t, pose.piece, nxt)
+            get_out_of_the_way(t, pose.piece, nxt, target)
             prev_t, prev_lift, prev_piece = t, lift, pose.piece
             landed.append((t, lift, target, pose.piece))
         self._lists[hand] = (pt, pv, pp, lt, lv, lp, landed)

@@ -212,6 +212,11 @@ class HandMoveTable(Schema):
     rest_move_s: float
 
 
+class HandReachTable(Schema):
+    speed_m_s: float
+    max_m: float
+
+
 class HandArticulationTable(Schema):
     side_stick_m: float
     rim_min_m: float
@@ -223,6 +228,7 @@ class DrummerHandsFile(Schema):
     lift: HandLiftTable
     time: HandTimeTable
     move: HandMoveTable
+    reach: HandReachTable
     articulation: HandArticulationTable
     enabled: bool = True
 
@@ -250,6 +256,8 @@ def hand_settings(path: Path) -> HandSettings:
         move_speed_m_s=f.move.speed_m_s,
         rest_after_s=f.move.rest_after_s,
         rest_move_s=f.move.rest_move_s,
+        reach_speed_m_s=f.reach.speed_m_s,
+        reach_max_m=f.reach.max_m,
     )
     positive = {
         "lift.per_s": settings.lift_per_s,
@@ -258,6 +266,7 @@ def hand_settings(path: Path) -> HandSettings:
         "move.speed_m_s": settings.move_speed_m_s,
         "move.rest_after_s": settings.rest_after_s,
         "move.rest_move_s": settings.rest_move_s,
+        "reach.speed_m_s": settings.reach_speed_m_s,
     }
     for name, value in positive.items():
         if not value > 0:

@@ -601,45 +601,27 @@ def _step(
         base = nrow * n_rl + max(nr, 0) * n_lefts + max(nl, 0)
         steps.append((k, pens, first, pair, base, (nr < 0) + 2 * (nl < 0)))
     cur_rl, cur_lefts = len(layer.rights) * len(layer.lefts), len(layer.lefts)
+    shared = (
+        layer.keys,
+        accs,
+        cur_rl,
+        cur_lefts,
+        row_costs,
+        row_kept,
+        right_kept,
+        right_class,
+        left_kept,
+        left_class,
+        steps,
+        n_rl,
+        n_lefts,
+    )
     merged = None
     core = fastdp.core
     if core is not None:  # the same loop compiled (virja/plan/_dpcore.c)
-        merged = core.hand_layer(
-            layer.keys,
-            accs,
-            cur_rl,
-            cur_lefts,
-            row_costs,
-            row_kept,
-            right_kept,
-            right_class,
-            left_kept,
-            left_class,
-            steps,
-            n_rl,
-            n_lefts,
-            len(next_rows),
-            drop_k,
-            drop_pen,
-        )
+        merged = core.hand_layer(*shared, len(next_rows), drop_k, drop_pen)
     if merged is None:
-        merged = _merge_layer(
-            layer.keys,
-            accs,
-            cur_rl,
-            cur_lefts,
-            row_costs,
-            row_kept,
-            right_kept,
-            right_class,
-            left_kept,
-            left_class,
-            steps,
-            n_rl,
-            n_lefts,
-            drop_k,
-            drop_pen,
-        )
+        merged = _merge_layer(*shared, drop_k, drop_pen)
     keys, nacc, codes = merged
     return (
         list(next_rows),  # type: ignore[arg-type]  # numbered in insertion order

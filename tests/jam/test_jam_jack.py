@@ -27,7 +27,7 @@ pytestmark = pytest.mark.jack
 if TYPE_CHECKING:
     from tests.jam.conftest import JackKeyboard, Recorder
 
-from tests.jam.conftest import wait_until  # noqa: E402
+from tests.jam.conftest import wait_connected, wait_until  # noqa: E402
 
 
 class JackSynth:
@@ -91,6 +91,7 @@ def test_notes_sent_to_the_virtual_port_arrive(jack_server: str, recorder: Recor
         out = rtmidi.MidiOut(rtmidi.API_UNIX_JACK, "kbd-direct")
     try:
         out.open_port(out.get_ports().index(port.name))
+        wait_connected(port.name)
         before = time.monotonic()
         out.send_message([0x90, 40, 100])
         out.send_message([0x80, 40, 0])

@@ -4,7 +4,9 @@ Usage:  .venv/bin/python tools/mma_jazz.py OUT_DIR [--tempos 60,90,...,300]
 
 Writes one MIDI file per groove and tempo (a 16-bar rhythm-changes-like
 progression with an intro, fills and an ending), made by the `mma` program
-(Debian package mma; not needed by the tests).  Then, for example:
+(Debian package mma; not needed by the tests).  MMA's grooves randomise timing,
+velocity and skipped notes; the files are made with a fixed seed (`--seed`,
+default 1) so two runs, on two machines, make the same sessions.  Then, for example:
     .venv/bin/python tools/drum_corpus.py OUT_DIR
 """
 
@@ -41,10 +43,11 @@ CHORDS = [
 ]
 
 
-def song(groove: str, tempo: int) -> str:
+def song(groove: str, tempo: int, seed: int = 1) -> str:
     bars = [f"{i + 1} {c}" for i, c in enumerate(CHORDS)]
     return "\n".join(
         [
+            f"RndSeed {seed}",  # MMA's grooves randomise timing and skips: fix them
             f"Tempo {tempo}",
             f"Groove {groove}",
             *bars[:7],
@@ -82,6 +85,12 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="folder for the .mma and .mid files")
     ap.add_argument("--tempos", default=",".join(map(str, TEMPOS)))
+    ap.add_argument(
+        "--seed",
+        type=int,
+        default=1,
+        help="MMA's random seed (RndSeed): the same seed makes the same files every time",
+    )
     a = ap.parse_args(argv)
     mma = shutil.which("mma")
     if mma is None:
@@ -94,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     for groove in GROOVES:
         for tempo in tempos:
             src = out / f"{groove.lower()}_{tempo}.mma"
-            src.write_text(song(groove, tempo))
+            src.write_text(song(groove, tempo, a.seed))
             r = subprocess.run([mma, str(src)], capture_output=True, text=True, timeout=120)
             if r.returncode != 0 or not src.with_suffix(".mid").exists():
                 print(f"error: mma failed on {src}: {r.stdout[-300:]}", file=sys.stderr)

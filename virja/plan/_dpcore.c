@@ -577,6 +577,300 @@ done:
     return result;
 }
 
+/* ------------------------------------------------------------ hand_window */
+
+typedef struct {
+    double cost;
+    Py_ssize_t index;
+} Ranked;
+
+/* keep_best's order (virja.plan.bounds): by cost, ties by index (a stable sort) */
+static int ranked_cmp(const void *a, const void *b) {
+    const Ranked *x = a, *y = b;
+    if (x->cost < y->cost) return -1;
+    if (y->cost < x->cost) return 1;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+static int index_cmp(const void *a, const void *b) {
+    Py_ssize_t x = *(const Py_ssize_t *)a, y = *(const Py_ssize_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* virja.plan.bounds.keep_best applied to (keys, accs, codes): each replaced by the
+ * ``beam`` entries of least cost in their order when there are more.  0 done, 1 refused
+ * (a NaN cost: the Python loop decides), -1 error. */
+static int keep_best_lists(PyObject **keys, PyObject **accs, PyObject **codes,
+                           Py_ssize_t beam) {
+    Py_ssize_t n = PyList_GET_SIZE(*accs);
+    if (n <= beam) return 0;
+    Ranked *r = malloc(sizeof(Ranked) * (size_t)n);
+    Py_ssize_t *kept = malloc(sizeof(Py_ssize_t) * (size_t)(beam > 0 ? beam : 1));
+    if (!r || !kept) {
+        free(r);
+        free(kept);
+        PyErr_NoMemory();
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *c = PyList_GET_ITEM(*accs, i);
+        if (!PyFloat_CheckExact(c) || isnan(PyFloat_AS_DOUBLE(c))) {
+            free(r);
+            free(kept);
+            return 1;
+        }
+        r[i].cost = PyFloat_AS_DOUBLE(c);
+        r[i].index = i;
+    }
+    qsort(r, (size_t)n, sizeof(Ranked), ranked_cmp);
+    for (Py_ssize_t i = 0; i < beam; i++) kept[i] = r[i].index;
+    free(r);
+    qsort(kept, (size_t)beam, sizeof(Py_ssize_t), index_cmp);
+    PyObject **lists[3] = {keys, accs, codes};
+    for (int l = 0; l < 3; l++) {
+        PyObject *old = *lists[l], *out = PyList_New(beam);
+        if (!out) {
+            free(kept);
+            return -1;
+        }
+        for (Py_ssize_t i = 0; i < beam; i++) {
+            PyObject *v = PyList_GET_ITEM(old, kept[i]);
+            Py_INCREF(v);
+            PyList_SET_ITEM(out, i, v);
+        }
+        Py_DECREF(old);
+        *lists[l] = out;
+    }
+    free(kept);
+    return 0;
+}
+
+/* a layer's state i as its parts' numbers (virja.plan.drums._Layer.parts) */
+static void layer_parts(PyObject *layer, Py_ssize_t i, Py_ssize_t *ri, Py_ssize_t *rh,
+                        Py_ssize_t *lh) {
+    Py_ssize_t n_r = PyList_GET_SIZE(PyTuple_GET_ITEM(layer, 1));
+    Py_ssize_t n_l = PyList_GET_SIZE(PyTuple_GET_ITEM(layer, 2));
+    Py_ssize_t key = PyLong_AsSsize_t(PyList_GET_ITEM(PyTuple_GET_ITEM(layer, 3), i));
+    *ri = key / (n_r * n_l);
+    *rh = (key % (n_r * n_l)) / n_l;
+    *lh = key % n_l;
+}
+
+/* hand_window(rows, rights, lefts, times, groups, max_interval, rest_s, table, none_row,
+ *             none_index, beam)
+ * -> (option per group, per-stroke costs per group, state after each group, total) or
+ * None: the whole of virja.plan.drums.solve over a window, from the start state's parts
+ * (one row, one part per hand), each group ``groups[g]`` being _Compiled.window:
+ * (played, pens, right_plays, left_plays, drop_k, drop_pen, back) where back[k] lists
+ * option k's played strokes left hand first as (motion, stroke index), and
+ * ``times[g]`` its time.  Each layer is hand_step's, cut by the beam (a negative beam:
+ * none) as keep_best cuts it; the way back is solve's. */
+static PyObject *hand_window(PyObject *self, PyObject *args) {
+    PyObject *rows, *rights, *lefts, *times, *groups, *table, *none_row;
+    double max_interval, rest_s;
+    Py_ssize_t none_index, beam;
+    if (!PyArg_ParseTuple(args, "OOOOOddOOnn", &rows, &rights, &lefts, &times, &groups,
+                          &max_interval, &rest_s, &table, &none_row, &none_index, &beam))
+        return NULL;
+    if (!PyList_Check(times) || !PyList_Check(groups) ||
+        PyList_GET_SIZE(times) != PyList_GET_SIZE(groups) || !PyTuple_Check(table) ||
+        none_index < 0 || none_index >= PyTuple_GET_SIZE(table))
+        Py_RETURN_NONE;
+    Py_ssize_t n_groups = PyList_GET_SIZE(groups), n_table = PyTuple_GET_SIZE(table);
+    for (Py_ssize_t g = 0; g < n_groups; g++) {
+        PyObject *w = PyList_GET_ITEM(groups, g);
+        if (!PyFloat_CheckExact(PyList_GET_ITEM(times, g)) || !PyTuple_CheckExact(w) ||
+            PyTuple_GET_SIZE(w) != 7 || !PyTuple_CheckExact(PyTuple_GET_ITEM(w, 6)) ||
+            !PyLong_CheckExact(PyTuple_GET_ITEM(w, 4)))
+            Py_RETURN_NONE;
+    }
+    PyObject *result = NULL, *layers = NULL, *accs = NULL, *keys = NULL;
+    PyObject *ks = NULL, *pers = NULL, *states = NULL;
+    PyObject *mi = PyFloat_FromDouble(max_interval), *rs = PyFloat_FromDouble(rest_s);
+    /* layers[g]: (rows, rights, lefts, keys, codes, n_options) after group g;
+     * layers[0] the start */
+    layers = PyList_New(0);
+    accs = Py_BuildValue("[d]", 0.0);
+    keys = Py_BuildValue("[n]", (Py_ssize_t)0);
+    if (!layers || !accs || !keys || !mi || !rs) goto done;
+    {
+        PyObject *start = Py_BuildValue("(OOOOOn)", rows, rights, lefts, keys, keys,
+                                        (Py_ssize_t)1);
+        if (!start || PyList_Append(layers, start) < 0) {
+            Py_XDECREF(start);
+            goto done;
+        }
+        Py_DECREF(start);
+    }
+    for (Py_ssize_t g = 0; g < n_groups; g++) {
+        PyObject *w = PyList_GET_ITEM(groups, g);
+        PyObject *before = PyList_GET_ITEM(layers, g);
+        PyObject *call = PyTuple_Pack(
+            16, PyTuple_GET_ITEM(before, 0), PyTuple_GET_ITEM(before, 1),
+            PyTuple_GET_ITEM(before, 2), keys, accs, PyList_GET_ITEM(times, g), mi, rs, table,
+            none_row, PyTuple_GET_ITEM(w, 0), PyTuple_GET_ITEM(w, 1), PyTuple_GET_ITEM(w, 2),
+            PyTuple_GET_ITEM(w, 3), PyTuple_GET_ITEM(w, 4), PyTuple_GET_ITEM(w, 5));
+        if (!call) goto done;
+        PyObject *stepped = hand_step(NULL, call);
+        Py_DECREF(call);
+        if (!stepped) goto done;
+        if (stepped == Py_None) {
+            result = stepped;
+            goto done;
+        }
+        PyObject *nkeys = PyTuple_GET_ITEM(stepped, 3), *nacc = PyTuple_GET_ITEM(stepped, 4);
+        PyObject *codes = PyTuple_GET_ITEM(stepped, 5);
+        Py_INCREF(nkeys);
+        Py_INCREF(nacc);
+        Py_INCREF(codes);
+        if (beam >= 0) {
+            int cut = keep_best_lists(&nkeys, &nacc, &codes, beam);
+            if (cut != 0) {
+                Py_DECREF(nkeys);
+                Py_DECREF(nacc);
+                Py_DECREF(codes);
+                Py_DECREF(stepped);
+                if (cut > 0) {
+                    result = Py_None;
+                    Py_INCREF(result);
+                }
+                goto done;
+            }
+        }
+        PyObject *layer = Py_BuildValue(
+            "(OOONNn)", PyTuple_GET_ITEM(stepped, 0), PyTuple_GET_ITEM(stepped, 1),
+            PyTuple_GET_ITEM(stepped, 2), nkeys, codes,
+            PyLong_AsSsize_t(PyTuple_GET_ITEM(w, 4)) + 1);
+        Py_DECREF(stepped);
+        Py_SETREF(accs, nacc);
+        if (!layer) goto done;
+        Py_SETREF(keys, PyTuple_GET_ITEM(layer, 3));
+        Py_INCREF(keys);
+        if (PyList_Append(layers, layer) < 0) {
+            Py_DECREF(layer);
+            goto done;
+        }
+        Py_DECREF(layer);
+    }
+    /* the first state (in layer order) of least objective */
+    Py_ssize_t n_end = PyList_GET_SIZE(accs), end = 0;
+    if (n_end == 0) {
+        result = Py_None;
+        Py_INCREF(result);
+        goto done;
+    }
+    double best = PyFloat_AsDouble(PyList_GET_ITEM(accs, 0));
+    for (Py_ssize_t i = 1; i < n_end; i++) {
+        double a = PyFloat_AsDouble(PyList_GET_ITEM(accs, i));
+        if (a < best) best = a, end = i;
+    }
+    if (PyErr_Occurred()) goto done;
+    ks = PyList_New(n_groups);
+    pers = PyList_New(n_groups);
+    states = PyList_New(n_groups);
+    if (!ks || !pers || !states) goto done;
+    Py_ssize_t cur = end;
+    for (Py_ssize_t g = n_groups - 1; g >= 0; g--) {
+        PyObject *after = PyList_GET_ITEM(layers, g + 1), *before = PyList_GET_ITEM(layers, g);
+        PyObject *w = PyList_GET_ITEM(groups, g);
+        Py_ssize_t n_options = PyLong_AsSsize_t(PyTuple_GET_ITEM(after, 5));
+        Py_ssize_t code = PyLong_AsSsize_t(PyList_GET_ITEM(PyTuple_GET_ITEM(after, 4), cur));
+        if (code == -1 && PyErr_Occurred()) goto done;
+        Py_ssize_t prev_id = code / n_options, k = code % n_options;
+        Py_ssize_t ri, rh, lh;
+        layer_parts(before, prev_id, &ri, &rh, &lh);
+        PyObject *row = PyList_GET_ITEM(PyTuple_GET_ITEM(before, 0), ri);
+        PyObject *prev = PyTuple_GET_ITEM(row, 0), *prev_t = PyTuple_GET_ITEM(row, 1);
+        Py_ssize_t r = none_index;
+        if (prev != Py_None && prev_t != Py_None &&
+            PyFloat_AS_DOUBLE(PyList_GET_ITEM(times, g)) - PyFloat_AS_DOUBLE(prev_t) < rest_s) {
+            r = PyLong_AsSsize_t(prev);
+            if (r == -1 && PyErr_Occurred()) goto done;
+        }
+        PyObject *back = PyTuple_GET_ITEM(w, 6);
+        if (k >= PyTuple_GET_SIZE(back)) {
+            result = Py_None;
+            Py_INCREF(result);
+            goto done;
+        }
+        PyObject *opt = PyTuple_GET_ITEM(back, k); /* (n strokes, (motion, stroke), ...) */
+        if (!PyTuple_CheckExact(opt) || PyTuple_GET_SIZE(opt) < 1) {
+            result = Py_None;
+            Py_INCREF(result);
+            goto done;
+        }
+        Py_ssize_t n_strokes = PyLong_AsSsize_t(PyTuple_GET_ITEM(opt, 0));
+        if (n_strokes < 0) goto done_refused;
+        PyObject *per = PyTuple_New(n_strokes);
+        if (!per) goto done;
+        for (Py_ssize_t i = 0; i < n_strokes; i++) {
+            PyObject *zero = PyFloat_FromDouble(0.0);
+            if (!zero) {
+                Py_DECREF(per);
+                goto done;
+            }
+            PyTuple_SET_ITEM(per, i, zero);
+        }
+        for (Py_ssize_t j = 1; j < PyTuple_GET_SIZE(opt); j++) {
+            PyObject *pm = PyTuple_GET_ITEM(opt, j);
+            if (!PyTuple_CheckExact(pm) || PyTuple_GET_SIZE(pm) != 2) {
+                Py_DECREF(per);
+                goto done_refused;
+            }
+            Py_ssize_t m = PyLong_AsSsize_t(PyTuple_GET_ITEM(pm, 0));
+            Py_ssize_t i = PyLong_AsSsize_t(PyTuple_GET_ITEM(pm, 1));
+            if (r < 0 || r >= n_table || i < 0 || i >= n_strokes) {
+                Py_DECREF(per);
+                result = Py_None;
+                Py_INCREF(result);
+                goto done;
+            }
+            PyObject *trow = PyTuple_GET_ITEM(table, r);
+            if (!PyTuple_Check(trow) || m < 0 || m >= PyTuple_GET_SIZE(trow)) {
+                Py_DECREF(per);
+                result = Py_None;
+                Py_INCREF(result);
+                goto done;
+            }
+            PyObject *c = PyTuple_GET_ITEM(trow, m);
+            Py_INCREF(c);
+            Py_SETREF(PyTuple_GET_ITEM(per, i), c);
+            r = m;
+        }
+        PyList_SET_ITEM(pers, g, per);
+        PyObject *kk = PyLong_FromSsize_t(k);
+        if (!kk) goto done;
+        PyList_SET_ITEM(ks, g, kk);
+        layer_parts(after, cur, &ri, &rh, &lh);
+        PyObject *arow = PyList_GET_ITEM(PyTuple_GET_ITEM(after, 0), ri);
+        PyObject *aright = PyList_GET_ITEM(PyTuple_GET_ITEM(after, 1), rh);
+        PyObject *aleft = PyList_GET_ITEM(PyTuple_GET_ITEM(after, 2), lh);
+        PyObject *st = PyTuple_Pack(6, PyTuple_GET_ITEM(arow, 0), PyTuple_GET_ITEM(arow, 1),
+                                    PyTuple_GET_ITEM(aright, 0), PyTuple_GET_ITEM(aleft, 0),
+                                    PyTuple_GET_ITEM(aright, 1), PyTuple_GET_ITEM(aleft, 1));
+        if (!st) goto done;
+        PyList_SET_ITEM(states, g, st);
+        cur = prev_id;
+    }
+    result = Py_BuildValue("(OOOO)", ks, pers, states, PyList_GET_ITEM(accs, end));
+    goto done;
+done_refused:
+    if (!PyErr_Occurred()) {
+        result = Py_None;
+        Py_INCREF(result);
+    }
+done:
+    Py_XDECREF(layers);
+    Py_XDECREF(accs);
+    Py_XDECREF(keys);
+    Py_XDECREF(ks);
+    Py_XDECREF(pers);
+    Py_XDECREF(states);
+    Py_XDECREF(mi);
+    Py_XDECREF(rs);
+    return result;
+}
+
 /* ------------------------------------------------------------ bass_solve */
 
 /* A bass state (string, fret, hand position) coded as one integer; -1: None. */
@@ -937,6 +1231,7 @@ static PyMethodDef methods[] = {
     {"hand_layer", hand_layer, METH_VARARGS, "One layer of the hand DP (virja.plan.drums)."},
     {"hand_parts", hand_parts, METH_VARARGS, "One hand's parts of a layer (virja.plan.drums)."},
     {"hand_step", hand_step, METH_VARARGS, "One group of the hand DP (virja.plan.drums)."},
+    {"hand_window", hand_window, METH_VARARGS, "A window of the hand DP (virja.plan.drums)."},
     {"bass_solve", bass_solve, METH_VARARGS, "The bass DP (virja.plan.bass.solve)."},
     {NULL, NULL, 0, NULL},
 };

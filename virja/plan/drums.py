@@ -296,6 +296,10 @@ class _Compiled:
     right_plays: tuple[tuple[float, _Need, _Classed], ...]
     left_plays: tuple[tuple[float, _Need, _Classed], ...]
     pens: tuple[tuple[float, ...], ...]
+    # what ``_dpcore.c``'s ``hand_window`` takes of a group: (played, pens, right_plays,
+    # left_plays, the drop option's index, its penalty, per option (number of strokes,
+    # (motion, stroke index) of each played stroke left hand first): the way back)
+    window: tuple[object, ...]
 
 
 def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
@@ -357,6 +361,16 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     by_class.append(total)
             pens.append(tuple(by_class))
     assert not opts[-1].played  # the all-drop option is last
+    back = tuple((len(strokes), *((m, i) for _r, m, _p, _dt, i in o.played)) for o in opts)
+    window = (
+        tuple(flat),
+        tuple(pens),
+        tuple(right_plays),
+        tuple(left_plays),
+        len(opts) - 1,
+        opts[-1].penalty,
+        back,
+    )
     return _Compiled(
         tuple(opts),
         tuple(flat),
@@ -364,6 +378,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
         tuple(right_plays),
         tuple(left_plays),
         tuple(pens),
+        window,
     )
 
 
@@ -690,17 +705,38 @@ def solve(
     table = costs.table
     none_row = table[costs.none_row]
     prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
+    compiled_all = [_compiled(costs, timing, group.strokes) for group in groups]
+    core = fastdp.core
+    if core is not None:  # the whole window compiled (virja/plan/_dpcore.c)
+        whole = core.hand_window(
+            [(prev0, prev_t0)],
+            [(t_right0, p_right0)],
+            [(t_left0, p_left0)],
+            [group.time for group in groups],
+            [comp.window for comp in compiled_all],
+            max_interval,
+            rest_s,
+            table,
+            none_row,
+            costs.none_row,
+            -1 if beam is None else beam,
+        )
+        if whole is not None:
+            ks, w_pers, w_states, w_total = whole
+            return HandSolution(
+                tuple(comp.options[k].assign for comp, k in zip(compiled_all, ks, strict=True)),
+                tuple(w_pers),
+                tuple(w_states),
+                w_total,
+            )
     start = _Layer([(prev0, prev_t0)], [(t_right0, p_right0)], [(t_left0, p_left0)], [0], [0], 1)
     layer = start
     accs: list[float] = [0.0]  # least objective reaching each state of the layer
     # per group: the layer after it, with its back-pointers (``_Layer.came``); the
     # per-stroke costs are recomputed once on the way back
     layers: list[_Layer] = []
-    compiled_all = []
-    for group in groups:
+    for group, comp in zip(groups, compiled_all, strict=True):
         t = group.time
-        comp = _compiled(costs, timing, group.strokes)
-        compiled_all.append(comp)
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
         stepped = None

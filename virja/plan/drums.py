@@ -24,6 +24,7 @@ Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -296,10 +297,11 @@ class _Compiled:
     right_plays: tuple[tuple[float, _Need, _Classed], ...]
     left_plays: tuple[tuple[float, _Need, _Classed], ...]
     pens: tuple[tuple[float, ...], ...]
-    # what ``_dpcore.c``'s ``hand_window`` takes of a group: (played, pens, right_plays,
-    # left_plays, the drop option's index, its penalty, per option (number of strokes,
-    # (motion, stroke index) of each played stroke left hand first): the way back)
-    window: tuple[object, ...]
+    # what ``_dpcore.c``'s ``hand_window`` takes of a group: its options as doubles
+    # (:func:`_native`; None when a piece is not a hand's), and per option (number of
+    # strokes, (motion, stroke index) of each played stroke left hand first): the way back
+    native: array[float] | None
+    back: tuple[tuple[object, ...], ...]
 
 
 def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
@@ -362,15 +364,6 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
             pens.append(tuple(by_class))
     assert not opts[-1].played  # the all-drop option is last
     back = tuple((len(strokes), *((m, i) for _r, m, _p, _dt, i in o.played)) for o in opts)
-    window = (
-        tuple(flat),
-        tuple(pens),
-        tuple(right_plays),
-        tuple(left_plays),
-        len(opts) - 1,
-        opts[-1].penalty,
-        back,
-    )
     return _Compiled(
         tuple(opts),
         tuple(flat),
@@ -378,8 +371,74 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
         tuple(right_plays),
         tuple(left_plays),
         tuple(pens),
-        window,
+        _native(flat, right_plays, left_plays, pens, len(opts) - 1, opts[-1].penalty),
+        back,
     )
+
+
+# the pieces a hand part may hold, numbered for ``_dpcore.c``'s ``hand_window`` (0: none)
+_PIECES: tuple[str | None, ...] = (None, *HAND_PIECES)
+_PIECE_NUMBER = {piece: i for i, piece in enumerate(_PIECES)}
+
+
+def _native(
+    flat: list[_Played],
+    right_plays: list[tuple[float, _Need, _Classed]],
+    left_plays: list[tuple[float, _Need, _Classed]],
+    pens: list[tuple[float, ...]],
+    drop_k: int,
+    drop_pen: float,
+) -> array[float] | None:
+    """A group's compiled options as ``_dpcore.c``'s ``hand_window`` reads them, one
+    array of doubles (small integers are exact in a double): ``[n_played, drop_k,
+    drop_pen, n_pieces]``; per played option ``[option, first motion, pair cost, last
+    motion, right piece (-1: it does not play), right dt, left piece, left dt, offset of
+    its penalties by class, their number]``; per played option, hand (right, left) and
+    previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of the
+    steps, their number]``; then the penalties and the steps ``(time, class)``.  None
+    when a piece is not one of :data:`_PIECES` (the Python loop then runs)."""
+    n = len(flat)
+    head = [float(n), float(drop_k), drop_pen, float(len(_PIECES))]
+    recs: list[float] = []
+    needs: list[float] = []
+    tail: list[float] = []
+    base = len(head) + 10 * n + 8 * n * len(_PIECES)
+    steps_at: list[tuple[int, tuple[tuple[float, int], ...]]] = []
+    for played, by_class, sides in zip(
+        flat, pens, zip(right_plays, left_plays, strict=True), strict=True
+    ):
+        k, r_piece, r_dt, _rs, _rr, l_piece, l_dt, _ls, _lr, last, _pen, first, pair = played
+        if (r_piece is not None and r_piece not in _PIECE_NUMBER) or (
+            l_piece is not None and l_piece not in _PIECE_NUMBER
+        ):
+            return None
+        recs += [float(k), float(first), pair, float(last)]
+        recs += [-1.0 if r_piece is None else float(_PIECE_NUMBER[r_piece]), r_dt]
+        recs += [-1.0 if l_piece is None else float(_PIECE_NUMBER[l_piece]), l_dt]
+        recs += [float(base + len(tail)), float(len(by_class))]
+        tail += by_class
+        for _dt, reach, classed in sides:
+            for prev in _PIECES:
+                limit, st = classed[prev]
+                needs += [reach[prev], limit, 0.0, float(len(st))]
+                steps_at.append((len(needs) - 2, st))
+    for at, st in steps_at:  # the steps after the penalties
+        needs[at] = float(base + len(tail))
+        for time, cls in st:
+            tail += [time, float(cls)]
+    return array("d", head + recs + needs + tail)
+
+
+def _table_native(costs: DrumCosts) -> array[float]:
+    """The cost table's rows as one array of doubles (``hand_window``'s ``table``)."""
+    global _table_cache
+    entry = _table_cache
+    if entry is None or entry[0] is not costs:
+        entry = _table_cache = (costs, array("d", [c for row in costs.table for c in row]))
+    return entry[1]
+
+
+_table_cache: tuple[DrumCosts, array[float]] | None = None
 
 
 # Compiled options depend only on (costs, timing, strokes), not on the group's time, so
@@ -707,19 +766,27 @@ def solve(
     prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
     compiled_all = [_compiled(costs, timing, group.strokes) for group in groups]
     core = fastdp.core
-    if core is not None:  # the whole window compiled (virja/plan/_dpcore.c)
+    pr0, pl0 = _PIECE_NUMBER.get(p_right0), _PIECE_NUMBER.get(p_left0)
+    natives = [comp.native for comp in compiled_all]
+    if (
+        core is not None
+        and pr0 is not None
+        and pl0 is not None
+        and None not in natives
+        and all(len(row) == len(table[0]) for row in table)
+    ):  # the whole window compiled (virja/plan/_dpcore.c)
         whole = core.hand_window(
-            [(prev0, prev_t0)],
-            [(t_right0, p_right0)],
-            [(t_left0, p_left0)],
+            (prev0, prev_t0, t_right0, t_left0, pr0, pl0),
             [group.time for group in groups],
-            [comp.window for comp in compiled_all],
+            natives,
+            [comp.back for comp in compiled_all],
+            _table_native(costs),
+            len(table[0]),
+            costs.none_row,
             max_interval,
             rest_s,
-            table,
-            none_row,
-            costs.none_row,
             -1 if beam is None else beam,
+            _PIECES,
         )
         if whole is not None:
             ks, w_pers, w_states, w_total = whole

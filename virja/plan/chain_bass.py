@@ -31,13 +31,17 @@ class BassChain(Chain[Held]):
         # bass.chord_options by the chord's pitches, for this chain's setup (which never
         # changes): looked up without hashing the setup again for every group
         self._chords: dict[tuple[int, ...], tuple[int, tuple[bass_mod.BassOption, ...]]] = {}
+        self._lowest, self._highest = self._setup.lowest, self._setup.highest
+        self._string_names = tuple(name for name, _open in self._setup.strings)
 
     def held(self, seq: int, note: NoteOn, known_s: float) -> Held:
         """``note`` as this chain holds it: folded into the bass's range (reported
         as moved when it had to be)."""
-        played = bass_mod.fold_into_range(self.ctx.config.bass, note.note)
-        if played != note.note:
-            self.ctx.ledger.move("bass", note, played)
+        played = note.note
+        if not self._lowest <= played <= self._highest:
+            played = bass_mod.fold_into_range(self._setup, played)
+            if played != note.note:
+                self.ctx.ledger.move("bass", note, played)
         return Held(seq, "bass", note, known_s, "pluck", played)
 
     def forget_plan(self) -> None:
@@ -103,7 +107,7 @@ class BassChain(Chain[Held]):
                 self.drop(rec, "no_double_stop")
                 continue
             s, f = where[rec.played]
-            pluck = bass_mod.motion_key(self.ctx.config.bass.strings[s][0], f, hand)
+            pluck = bass_mod.motion_key(self._string_names[s], f, hand)
             self.emit(
                 rec,
                 limb="right_hand",

@@ -635,14 +635,15 @@ static int ranked_cmp(const void *a, const void *b) {
 }
 
 /* a group's window data (virja.plan.drums._Compiled.native), as doubles:
- * [n_played, drop_k, drop_pen, n_pieces], then per played option (10 each): option
+ * [n_played, drop_k, drop_pen, n_pieces], then per played option (13 each): option
  * index, first motion, pair cost, last motion, right piece (-1: does not play), right
- * dt, left piece, left dt, offset of its penalties by class, their number; then per
- * played option, hand (right, left) and previous piece (4 each): reach, the steps'
- * largest time, offset of its steps, their number; then the penalties and the steps
- * (time, class). */
+ * dt, left piece, left dt, offset of its penalties by class, their number, offset of
+ * the right hand's block, of the left hand's, the right hand's class scale; then the
+ * penalties; then the blocks (drums._block): per previous piece (4 each) reach, the
+ * steps' largest time, offset of its steps from the block, their number; then the
+ * steps (time, penalty number). */
 #define W_HEAD 4
-#define W_REC 10
+#define W_REC 13
 #define W_NEED 4
 
 static void free_layer(WLayer *l) {
@@ -775,12 +776,29 @@ static PyObject *hand_window(PyObject *self, PyObject *args) {
         long long drop_k = (long long)w[1];
         double drop_pen = w[2];
         Py_ssize_t wp = (Py_ssize_t)w[3];
-        if (n_played < 0 || wp != n_pieces ||
-            w_len < W_HEAD + n_played * W_REC + n_played * 2 * wp * W_NEED) {
+        if (n_played < 0 || wp != n_pieces || w_len < W_HEAD + n_played * W_REC) {
             refused = 1;
             goto done;
         }
-        const double *rec = w + W_HEAD, *needs = rec + n_played * W_REC;
+        const double *rec = w + W_HEAD;
+        /* every block and its steps inside the data */
+        for (Py_ssize_t j = 0; j < n_played; j++) {
+            for (int side = 0; side < 2; side++) {
+                Py_ssize_t boff = (Py_ssize_t)rec[j * W_REC + (side ? 11 : 10)];
+                if (boff < 0 || boff + wp * W_NEED > w_len) {
+                    refused = 1;
+                    goto done;
+                }
+                for (Py_ssize_t q = 0; q < wp; q++) {
+                    const double *nd = w + boff + q * W_NEED;
+                    Py_ssize_t off = (Py_ssize_t)nd[2], cnt = (Py_ssize_t)nd[3];
+                    if (off < 0 || cnt < 0 || boff + off + 2 * cnt > w_len) {
+                        refused = 1;
+                        goto done;
+                    }
+                }
+            }
+        }
         double t = PyFloat_AS_DOUBLE(PyList_GET_ITEM(times, g));
         WLayer *cur = &layers[g], *nxt = &layers[g + 1];
         Py_ssize_t n = cur->n;
@@ -837,20 +855,19 @@ static PyObject *hand_window(PyObject *self, PyObject *args) {
                 }
                 kept[i] = part_number(next, n_next, keep);
                 for (Py_ssize_t j = 0; j < n_played; j++) {
-                    const double *nd = needs + ((j * 2 + side) * wp + p.piece) * W_NEED;
-                    double x = since + rec[j * W_REC + (side ? 7 : 5)];
+                    const double *o = rec + j * W_REC;
+                    const double *blk = w + (Py_ssize_t)o[side ? 11 : 10];
+                    const double *nd = blk + p.piece * W_NEED;
+                    double x = since + o[side ? 7 : 5];
                     long long c = 0;
                     if (x < nd[0]) {
                         c = DPCORE_INFEASIBLE;
                     } else if (x < nd[1]) {
-                        Py_ssize_t off = (Py_ssize_t)nd[2], cnt = (Py_ssize_t)nd[3];
-                        if (off < 0 || off + 2 * cnt > w_len) {
-                            refused = 1;
-                            goto done;
-                        }
+                        const double *st = blk + (Py_ssize_t)nd[2];
+                        Py_ssize_t cnt = (Py_ssize_t)nd[3];
                         for (Py_ssize_t q = 0; q < cnt; q++) {
-                            if (x < w[off + 2 * q]) {
-                                c = (long long)w[off + 2 * q + 1];
+                            if (x < st[2 * q]) {
+                                c = (long long)st[2 * q + 1] * (side ? 1 : (long long)o[12]);
                                 break;
                             }
                         }

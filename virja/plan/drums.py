@@ -283,6 +283,26 @@ def _classed(steps: _Steps, scale: int) -> tuple[_Classed, list[float]]:
     return out, levels
 
 
+def _classed_for(timing: Timing, piece: str | None, scale: int) -> tuple[_Classed, list[float]]:
+    """:func:`_classed` of the steps of a hand striking ``piece`` (:func:`_needs`), made
+    once per timing, piece and scale (shared, read only: every signature with that hand's
+    piece has them)."""
+    global _classed_cache
+    entry = _classed_cache
+    if entry is None or entry[0] is not timing:
+        entry = _classed_cache = (timing, {})
+    key = (piece, scale)
+    found = entry[1].get(key)
+    if found is None:
+        found = entry[1][key] = _classed(_needs(timing, piece)[0], scale)
+    return found
+
+
+_classed_cache: tuple[Timing, dict[tuple[str | None, int], tuple[_Classed, list[float]]]] | None = (
+    None
+)
+
+
 @dataclass(frozen=True, slots=True)
 class _Compiled:
     """Everything about a group's options that does not depend on its time."""
@@ -311,6 +331,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
     right_plays = []
     left_plays = []
     pens = []
+    scales: list[int] = []
     for k, assign in enumerate(options(HandGroup(0.0, strokes))):
         played = []
         penalty = 0.0
@@ -347,9 +368,10 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     costs.table[first][last] if len(played) == 2 else 0.0,
                 )
             )
-            l_classed, l_levels = _classed(l_steps, 1)
+            l_classed, l_levels = _classed_for(timing, l_piece, 1)
             n_left = len(l_levels)
-            r_classed, r_levels = _classed(r_steps, n_left)
+            scales.append(n_left)
+            r_classed, r_levels = _classed_for(timing, r_piece, n_left)
             right_plays.append((r_dt, r_reach, r_classed))
             left_plays.append((l_dt, l_reach, l_classed))
             by_class = []
@@ -371,7 +393,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
         tuple(right_plays),
         tuple(left_plays),
         tuple(pens),
-        _native(flat, right_plays, left_plays, pens, len(opts) - 1, opts[-1].penalty),
+        _native(timing, flat, pens, scales, len(opts) - 1, opts[-1].penalty),
         back,
     )
 
@@ -382,10 +404,10 @@ _PIECE_NUMBER = {piece: i for i, piece in enumerate(_PIECES)}
 
 
 def _native(
+    timing: Timing,
     flat: list[_Played],
-    right_plays: list[tuple[float, _Need, _Classed]],
-    left_plays: list[tuple[float, _Need, _Classed]],
     pens: list[tuple[float, ...]],
+    scales: list[int],
     drop_k: int,
     drop_pen: float,
 ) -> array[float] | None:
@@ -393,20 +415,18 @@ def _native(
     array of doubles (small integers are exact in a double): ``[n_played, drop_k,
     drop_pen, n_pieces]``; per played option ``[option, first motion, pair cost, last
     motion, right piece (-1: it does not play), right dt, left piece, left dt, offset of
-    its penalties by class, their number]``; per played option, hand (right, left) and
-    previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of the
-    steps, their number]``; then the penalties and the steps ``(time, class)``.  None
-    when a piece is not one of :data:`_PIECES` (the Python loop then runs)."""
+    its penalties by class, their number, offset of the right hand's block, of the left
+    hand's, the right hand's class scale (the left hand's number of penalties)]``; then
+    the penalties; then a block per hand piece met (:func:`_block`).  None when a piece
+    is not one of :data:`_PIECES` (the Python loop then runs)."""
     n = len(flat)
     head = [float(n), float(drop_k), drop_pen, float(len(_PIECES))]
     recs: list[float] = []
-    needs: list[float] = []
     tail: list[float] = []
-    base = len(head) + 10 * n + 8 * n * len(_PIECES)
-    steps_at: list[tuple[int, tuple[tuple[float, int], ...]]] = []
-    for played, by_class, sides in zip(
-        flat, pens, zip(right_plays, left_plays, strict=True), strict=True
-    ):
+    base = len(head) + 13 * n
+    where: dict[str | None, int] = {}  # each hand piece's block, placed once
+    blocks: list[list[float]] = []
+    for played, by_class, scale in zip(flat, pens, scales, strict=True):
         k, r_piece, r_dt, _rs, _rr, l_piece, l_dt, _ls, _lr, last, _pen, first, pair = played
         if (r_piece is not None and r_piece not in _PIECE_NUMBER) or (
             l_piece is not None and l_piece not in _PIECE_NUMBER
@@ -417,16 +437,53 @@ def _native(
         recs += [-1.0 if l_piece is None else float(_PIECE_NUMBER[l_piece]), l_dt]
         recs += [float(base + len(tail)), float(len(by_class))]
         tail += by_class
-        for _dt, reach, classed in sides:
-            for prev in _PIECES:
-                limit, st = classed[prev]
-                needs += [reach[prev], limit, 0.0, float(len(st))]
-                steps_at.append((len(needs) - 2, st))
-    for at, st in steps_at:  # the steps after the penalties
-        needs[at] = float(base + len(tail))
-        for time, cls in st:
-            tail += [time, float(cls)]
-    return array("d", head + recs + needs + tail)
+        for piece in (r_piece, l_piece):
+            if piece not in where:
+                where[piece] = len(blocks)
+                blocks.append(_block(timing, piece))
+        recs += [float(where[r_piece]), float(where[l_piece]), float(scale)]
+    at = base + len(tail)
+    starts = []
+    for block in blocks:
+        starts.append(float(at))
+        at += len(block)
+    for i in range(n):  # block numbers -> offsets
+        rec = recs[13 * i : 13 * i + 13]
+        recs[13 * i + 10] = starts[int(rec[10])]
+        recs[13 * i + 11] = starts[int(rec[11])]
+    out = array("d", head + recs + tail)
+    for block in blocks:
+        out.extend(block)
+    return out
+
+
+def _block(timing: Timing, piece: str | None) -> list[float]:
+    """What a hand striking ``piece`` (None: not playing) needs, as ``hand_window`` reads
+    it: per previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of
+    its steps from the block's start, their number]``, then the steps ``(time, penalty
+    number)``, the penalties numbered as :func:`_classed` numbers them (0 for none, then
+    as met).  The same for every group: made once per timing and piece."""
+    global _blocks_cache
+    entry = _blocks_cache
+    if entry is None or entry[0] is not timing:
+        entry = _blocks_cache = (timing, {})
+    found = entry[1].get(piece)
+    if found is None:
+        reach = _needs(timing, piece)[1]
+        classed = _classed_for(timing, piece, 1)[0]
+        head: list[float] = []
+        tail: list[float] = []
+        size = 4 * len(_PIECES)
+        for prev in _PIECES:
+            limit, st = classed[prev]
+            head += [reach[prev], limit, float(size + len(tail)), float(len(st))]
+            for time, cls in st:
+                tail += [time, float(cls)]
+        found = entry[1][piece] = head + tail
+    return found
+
+
+_blocks_cache: tuple[Timing, dict[str | None, list[float]]] | None = None
 
 
 def _table_native(costs: DrumCosts) -> array[float]:

@@ -10,7 +10,11 @@ with the source tree ``--before`` (a copy of another commit's ``virja`` package)
 with this checkout, ``--rounds`` times each.  It prints, per side, the medians over
 the rounds of each figure, the best round's p99, and the p50 and p99 of each beat's
 least time over the rounds (the same 300 beats each round: what is left when the
-other jobs on the machine are taken off).  Nothing is written.
+other jobs on the machine are taken off), and which path the DPs took on that side
+(``virja.plan.fastdp.path``: "compiled", or "pure" and why).  ``git archive`` carries
+no build: copy or build ``virja/plan/_dpcore*.so`` into the ``--before`` tree when it has
+a ``_dpcore.c``, or its side runs the Python loops (and says "pure (not built...)").
+Nothing is written.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import statistics
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -44,11 +49,15 @@ for w in workloads:
     beats.append((time.perf_counter() - start) * 1000)
 p50, p99 = plan_beat_ms(300)
 s50, s99 = plan_streamed_ms(200)
-print(json.dumps({"beats": beats, "figures": [p50, p99, s50, s99]}))
+from virja.plan import fastdp
+# a tree from before the path was reported says only whether its build was used
+path = fastdp.path() if hasattr(fastdp, "path") else (
+    "compiled" if fastdp.core is not None else "pure")
+print(json.dumps({"beats": beats, "figures": [p50, p99, s50, s99], "path": path}))
 """
 
 
-def run_side(source: Path | None) -> dict[str, list[float]]:
+def run_side(source: Path | None) -> dict[str, Any]:
     """One round in a fresh process: ``source``'s virja package first on the path
     (None: this checkout's)."""
     env = dict(os.environ)
@@ -61,11 +70,12 @@ def run_side(source: Path | None) -> dict[str, list[float]]:
     )
     if out.returncode != 0:
         raise SystemExit(f"plan_speed: the round failed: {out.stderr.strip().splitlines()[-1]}")
-    result: dict[str, list[float]] = json.loads(out.stdout)
+    result: dict[str, Any] = json.loads(out.stdout)
     return result
 
 
-def summary(name: str, rounds: list[dict[str, list[float]]]) -> str:
+def summary(name: str, rounds: list[dict[str, Any]]) -> str:
+    paths = sorted({r.get("path", "?") for r in rounds})
     figures = np.array([r["figures"] for r in rounds])
     least = np.array([r["beats"] for r in rounds]).min(axis=0)
     med = [statistics.median(figures[:, i]) for i in range(4)]
@@ -73,7 +83,8 @@ def summary(name: str, rounds: list[dict[str, list[float]]]) -> str:
         f"{name}: {len(rounds)} rounds | medians: plan p50 {med[0]:.3f} p99 {med[1]:.3f} ms, "
         f"streamed p50 {med[2]:.3f} p99 {med[3]:.3f} ms | best round's plan p99 "
         f"{figures[:, 1].min():.3f} ms | each beat's least: p50 "
-        f"{np.percentile(least, 50):.3f} p99 {np.percentile(least, 99):.3f} ms"
+        f"{np.percentile(least, 50):.3f} p99 {np.percentile(least, 99):.3f} ms | DP path: "
+        f"{', '.join(paths)}"
     )
 
 
@@ -86,8 +97,8 @@ def main() -> int:
         parser.error(f"--before {args.before}: no virja package there")
     if args.rounds < 1:
         parser.error("--rounds must be >= 1")
-    before: list[dict[str, list[float]]] = []
-    after: list[dict[str, list[float]]] = []
+    before: list[dict[str, Any]] = []
+    after: list[dict[str, Any]] = []
     for _ in range(args.rounds):
         before.append(run_side(args.before.resolve()))
         after.append(run_side(None))

@@ -198,6 +198,14 @@ async def _latency(n: int, rate_hz: float) -> tuple[float, float]:
 # -- planning -----------------------------------------------------------------
 
 
+def plan_path() -> str:
+    """Which path the planner's DPs take here: "compiled", or "pure" and why (not built,
+    a stale build, ``VIRJA_PLAN_PURE=1``): :func:`virja.plan.fastdp.path`."""
+    from virja.plan import fastdp
+
+    return fastdp.path()
+
+
 def plan_beat_ms(beats: int = 300) -> tuple[float, float]:
     """Planning one beat of 16 notes per performer known at once, p50 and p99 in ms."""
     from virja.plan.bench import beat_workload, plan_one_beat
@@ -559,7 +567,10 @@ def run_all(
     lf = load()
     pp50, pp99 = plan_beat_ms(int(300 * scale))
     s50, s99 = plan_streamed_ms(int(200 * scale))
-    note = f"p50 {pp50:.3f} ms; streamed note by note: p50 {s50:.2f} ms, p99 {s99:.2f} ms per beat"
+    note = (
+        f"p50 {pp50:.3f} ms; streamed note by note: p50 {s50:.2f} ms, p99 {s99:.2f} ms per "
+        f"beat; DP path: {plan_path()}"
+    )
     figs.append(Figure("plan_ms_p99", pp99, "ms", 1.0, False, note, load=lf))
     say("pose and scene")
     lf = load()

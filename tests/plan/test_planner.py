@@ -270,8 +270,32 @@ def test_a_long_session_keeps_bounded_tempo_and_report_history() -> None:
     p = planner_mod.OnlinePlanner()
     for i in range(planner_mod.MAX_BEATS_KEPT + 500):
         p.add_beat(Beat(i * 0.5, i // 4, 1 + i % 4, 4, 0, 500_000))
-    assert len(p._beat_times) == planner_mod.MAX_BEATS_KEPT
+    assert len(p._track.times) == planner_mod.MAX_BEATS_KEPT
     assert p.seconds_per_beat_at(1e9) == 0.5
+
+
+def test_a_planner_no_longer_used_is_freed_without_the_cyclic_collector() -> None:
+    """No reference cycle through the chains (their tempo look-up holds the tempo track,
+    not the planner): dropping the last reference frees the planner and its notes at
+    once, so planning makes no garbage for the cyclic collector to pause on."""
+    import gc
+    import weakref
+
+    planner = OnlinePlanner(tempo=T120)
+    for i in range(8):
+        planner.add_note("bass", NoteOn(1.0 + 0.25 * i, 0, 40 + i, 90), now_s=0.0)
+        planner.add_note("drums", NoteOn(1.0 + 0.25 * i, 9, 38, 90), now_s=0.0)
+    planner.poll(1.5)
+    assert planner.flush()
+    ref = weakref.ref(planner)
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        del planner
+        assert ref() is None
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def test_each_note_goes_to_its_chain_and_an_unknown_performer_is_refused() -> None:

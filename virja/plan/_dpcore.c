@@ -1,5 +1,7 @@
 /* The two dynamic programmes' inner loops in C (optional: virja.plan.fastdp).
  *
+ * hand_window: the whole of virja.plan.drums.solve over a window (every group's layer,
+ * the beam and the way back) on C arrays, one call per window.
  * hand_layer: one layer of virja.plan.drums.solve (the loop over a layer's states and a
  * group's options), the same visiting order, the same sums in the same order, the same
  * strict "<" merge, so every result is the Python loop's to the bit.
@@ -577,6 +579,559 @@ done:
     return result;
 }
 
+/* ------------------------------------------------------------ hand_window */
+
+/* A layer's part, as virja.plan.drums numbers them: a row (previous motion, -1 for
+ * None, and its time) or a hand's last stroke (its time, and its piece numbered in
+ * ``pieces``: 0 is None).  Two parts are the same when the Python tuples are equal. */
+typedef struct {
+    long long prev;
+    int has_t;
+    double t;
+} WRow;
+
+typedef struct {
+    int has;
+    double last;
+    long long piece;
+} WPart;
+
+typedef struct {
+    WRow *rows;
+    WPart *rights, *lefts;
+    long long *keys, *came;
+    Py_ssize_t n_rows, n_rights, n_lefts, n;
+    long long n_options;
+} WLayer;
+
+static Py_ssize_t row_number(WRow *rows, Py_ssize_t *n, WRow r) {
+    for (Py_ssize_t i = 0; i < *n; i++)
+        if (rows[i].prev == r.prev && rows[i].has_t == r.has_t && (!r.has_t || rows[i].t == r.t))
+            return i;
+    rows[*n] = r;
+    return (*n)++;
+}
+
+static Py_ssize_t part_number(WPart *parts, Py_ssize_t *n, WPart p) {
+    for (Py_ssize_t i = 0; i < *n; i++)
+        if (parts[i].has == p.has && (!p.has || parts[i].last == p.last) &&
+            parts[i].piece == p.piece)
+            return i;
+    parts[*n] = p;
+    return (*n)++;
+}
+
+typedef struct {
+    double cost;
+    Py_ssize_t index;
+} Ranked;
+
+/* keep_best's order (virja.plan.bounds): by cost, ties by index (a stable sort) */
+static int ranked_cmp(const void *a, const void *b) {
+    const Ranked *x = a, *y = b;
+    if (x->cost < y->cost) return -1;
+    if (y->cost < x->cost) return 1;
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+/* a group's window data (virja.plan.drums._Compiled.native), as doubles:
+ * [n_played, drop_k, drop_pen, n_pieces], then per played option (13 each): option
+ * index, first motion, pair cost, last motion, right piece (-1: does not play), right
+ * dt, left piece, left dt, offset of its penalties by class, their number, offset of
+ * the right hand's block, of the left hand's, the right hand's class scale; then the
+ * penalties; then the blocks (drums._block): per previous piece (4 each) reach, the
+ * steps' largest time, offset of its steps from the block, their number; then the
+ * steps (time, penalty number). */
+#define W_HEAD 4
+#define W_REC 13
+#define W_NEED 4
+
+static void free_layer(WLayer *l) {
+    free(l->rows);
+    free(l->rights);
+    free(l->lefts);
+    free(l->keys);
+    free(l->came);
+}
+
+static PyObject *none_or_float(int has, double v) {
+    if (!has) Py_RETURN_NONE;
+    return PyFloat_FromDouble(v);
+}
+
+/* hand_window(start, times, natives, backs, table, n_cols, none_index, max_interval,
+ *             rest_s, beam, pieces)
+ * -> (option per group, per-stroke costs per group, state after each group, total) or
+ * None: the whole of virja.plan.drums.solve over a window in C, on C arrays.
+ * ``start``: (prev, prev_t, t_right, t_left, right piece, left piece) with pieces
+ * numbered in ``pieces`` (0: None); ``natives[g]``: group g's window data (above) as a
+ * buffer of doubles; ``backs[g]``: per option (number of strokes, (motion, stroke
+ * index) of each played stroke, left hand first); ``table``: the cost table's rows as
+ * one buffer of doubles, ``n_cols`` to a row; ``beam`` < 0: none.  The same parts
+ * numbered in the same first-reached order, the same comparisons, sums in the same
+ * order and the same strict "<" merge as the Python loop (drums._step, _hand_parts,
+ * _merge_layer), keep_best's cut, and solve's way back. */
+static PyObject *hand_window(PyObject *self, PyObject *args) {
+    PyObject *start, *times, *natives, *backs, *table_o, *pieces;
+    Py_ssize_t n_cols, none_index, beam;
+    double max_interval, rest_s;
+    if (!PyArg_ParseTuple(args, "OOOOOnnddnO", &start, &times, &natives, &backs, &table_o,
+                          &n_cols, &none_index, &max_interval, &rest_s, &beam, &pieces))
+        return NULL;
+    if (!PyTuple_CheckExact(start) || PyTuple_GET_SIZE(start) != 6 || !PyList_Check(times) ||
+        !PyList_Check(natives) || !PyList_Check(backs) || !PyTuple_Check(pieces) ||
+        PyList_GET_SIZE(natives) != PyList_GET_SIZE(times) ||
+        PyList_GET_SIZE(backs) != PyList_GET_SIZE(times) || n_cols <= 0)
+        Py_RETURN_NONE;
+    Py_ssize_t n_groups = PyList_GET_SIZE(times), n_pieces = PyTuple_GET_SIZE(pieces);
+    for (Py_ssize_t g = 0; g < n_groups; g++) {
+        PyObject *t = PyList_GET_ITEM(times, g);
+        if (!PyFloat_CheckExact(t) || !isfinite(PyFloat_AS_DOUBLE(t))) Py_RETURN_NONE;
+    }
+    /* the start state's parts */
+    WRow row0;
+    WPart right0, left0;
+    {
+        PyObject *p = PyTuple_GET_ITEM(start, 0), *pt = PyTuple_GET_ITEM(start, 1);
+        PyObject *tr = PyTuple_GET_ITEM(start, 2), *tl = PyTuple_GET_ITEM(start, 3);
+        PyObject *pr = PyTuple_GET_ITEM(start, 4), *pl = PyTuple_GET_ITEM(start, 5);
+        if ((p != Py_None && !PyLong_CheckExact(p)) ||
+            (pt != Py_None && !PyFloat_CheckExact(pt)) ||
+            (tr != Py_None && !PyFloat_CheckExact(tr)) ||
+            (tl != Py_None && !PyFloat_CheckExact(tl)) || !PyLong_CheckExact(pr) ||
+            !PyLong_CheckExact(pl))
+            Py_RETURN_NONE;
+        row0.prev = p == Py_None ? -1 : PyLong_AsLongLong(p);
+        row0.has_t = pt != Py_None;
+        row0.t = row0.has_t ? PyFloat_AS_DOUBLE(pt) : 0.0;
+        right0.has = tr != Py_None;
+        right0.last = right0.has ? PyFloat_AS_DOUBLE(tr) : 0.0;
+        right0.piece = PyLong_AsLongLong(pr);
+        left0.has = tl != Py_None;
+        left0.last = left0.has ? PyFloat_AS_DOUBLE(tl) : 0.0;
+        left0.piece = PyLong_AsLongLong(pl);
+        if (PyErr_Occurred()) return NULL;
+        if ((p != Py_None && row0.prev < 0) || (row0.has_t && !isfinite(row0.t)) ||
+            (right0.has && !isfinite(right0.last)) || (left0.has && !isfinite(left0.last)) ||
+            right0.piece < 0 || right0.piece >= n_pieces || left0.piece < 0 ||
+            left0.piece >= n_pieces)
+            Py_RETURN_NONE;
+    }
+    Py_buffer table_b;
+    if (PyObject_GetBuffer(table_o, &table_b, PyBUF_SIMPLE) < 0) return NULL;
+    const double *table = table_b.buf;
+    Py_ssize_t n_trows = table_b.len / (Py_ssize_t)sizeof(double) / n_cols;
+    PyObject *result = NULL, *ks = NULL, *pers = NULL, *states = NULL;
+    Py_buffer *bufs = calloc((size_t)n_groups + 1, sizeof(Py_buffer));
+    WLayer *layers = calloc((size_t)n_groups + 1, sizeof(WLayer));
+    double *accs = NULL;
+    Ranked *ranked = NULL;
+    long long *rclass = NULL, *rkept = NULL, *m_row = NULL;
+    int32_t *index = NULL;
+    double *out_tot = NULL;
+    long long *out_keys = NULL, *out_came = NULL;
+    Py_ssize_t n_bufs = 0;
+    int refused = 0;
+    if (!bufs || !layers) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (none_index < 0 || none_index >= n_trows) {
+        refused = 1;
+        goto done;
+    }
+    for (Py_ssize_t g = 0; g < n_groups; g++) {
+        if (PyObject_GetBuffer(PyList_GET_ITEM(natives, g), &bufs[g], PyBUF_SIMPLE) < 0)
+            goto done;
+        n_bufs++;
+    }
+    /* the start layer: one state, key 0 */
+    {
+        WLayer *l = &layers[0];
+        l->rows = malloc(sizeof(WRow));
+        l->rights = malloc(sizeof(WPart));
+        l->lefts = malloc(sizeof(WPart));
+        l->keys = calloc(1, sizeof(long long));
+        l->came = calloc(1, sizeof(long long));
+        accs = malloc(sizeof(double));
+        if (!l->rows || !l->rights || !l->lefts || !l->keys || !l->came || !accs) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        l->rows[0] = row0;
+        l->rights[0] = right0;
+        l->lefts[0] = left0;
+        l->n_rows = l->n_rights = l->n_lefts = l->n = 1;
+        l->n_options = 1;
+        accs[0] = 0.0;
+    }
+    for (Py_ssize_t g = 0; g < n_groups; g++) {
+        const double *w = bufs[g].buf;
+        Py_ssize_t w_len = bufs[g].len / (Py_ssize_t)sizeof(double);
+        if (w_len < W_HEAD) {
+            refused = 1;
+            goto done;
+        }
+        Py_ssize_t n_played = (Py_ssize_t)w[0];
+        long long drop_k = (long long)w[1];
+        double drop_pen = w[2];
+        Py_ssize_t wp = (Py_ssize_t)w[3];
+        if (n_played < 0 || wp != n_pieces || w_len < W_HEAD + n_played * W_REC) {
+            refused = 1;
+            goto done;
+        }
+        const double *rec = w + W_HEAD;
+        /* every block and its steps inside the data */
+        for (Py_ssize_t j = 0; j < n_played; j++) {
+            for (int side = 0; side < 2; side++) {
+                Py_ssize_t boff = (Py_ssize_t)rec[j * W_REC + (side ? 11 : 10)];
+                if (boff < 0 || boff + wp * W_NEED > w_len) {
+                    refused = 1;
+                    goto done;
+                }
+                for (Py_ssize_t q = 0; q < wp; q++) {
+                    const double *nd = w + boff + q * W_NEED;
+                    Py_ssize_t off = (Py_ssize_t)nd[2], cnt = (Py_ssize_t)nd[3];
+                    if (off < 0 || cnt < 0 || boff + off + 2 * cnt > w_len) {
+                        refused = 1;
+                        goto done;
+                    }
+                }
+            }
+        }
+        double t = PyFloat_AS_DOUBLE(PyList_GET_ITEM(times, g));
+        WLayer *cur = &layers[g], *nxt = &layers[g + 1];
+        Py_ssize_t n = cur->n;
+        nxt->rows = malloc(sizeof(WRow) * (size_t)(cur->n_rows + n_played + 1));
+        nxt->rights = malloc(sizeof(WPart) * (size_t)(cur->n_rights + n_played + 1));
+        nxt->lefts = malloc(sizeof(WPart) * (size_t)(cur->n_lefts + n_played + 1));
+        free(rclass);
+        free(rkept);
+        free(m_row);
+        rclass = malloc(sizeof(long long) * (size_t)((cur->n_rights + cur->n_lefts) * n_played + 1));
+        rkept = malloc(sizeof(long long) * (size_t)(cur->n_rights + cur->n_lefts + 2 * cur->n_rows + 1));
+        m_row = malloc(sizeof(long long) * (size_t)(5 * n_played + 1));
+        if (!nxt->rows || !nxt->rights || !nxt->lefts || !rclass || !rkept || !m_row) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        long long *lclass = rclass + cur->n_rights * n_played;
+        long long *lkept = rkept + cur->n_rights, *rowkept = lkept + cur->n_lefts;
+        long long *rowcost = rowkept + cur->n_rows; /* the table row each row pays */
+        long long *m_r = m_row + n_played, *m_l = m_r + n_played, *m_base = m_l + n_played;
+        long long *m_keeps = m_base + n_played;
+        /* the rows: kept, forgotten after a rest, and what their first motion pays */
+        WRow none_row = {-1, 0, 0.0};
+        for (Py_ssize_t i = 0; i < cur->n_rows; i++) {
+            WRow r = cur->rows[i];
+            if (r.has_t && t - r.t >= rest_s) {
+                rowcost[i] = none_index;
+                rowkept[i] = row_number(nxt->rows, &nxt->n_rows, none_row);
+            } else {
+                rowcost[i] = (r.prev >= 0 && r.has_t) ? r.prev : none_index;
+                if (rowcost[i] >= n_trows) {
+                    refused = 1;
+                    goto done;
+                }
+                rowkept[i] = row_number(nxt->rows, &nxt->n_rows, r);
+            }
+        }
+        /* each hand's parts: kept or forgotten, and the class per played option */
+        for (int side = 0; side < 2; side++) {
+            WPart *parts = side ? cur->lefts : cur->rights;
+            Py_ssize_t m = side ? cur->n_lefts : cur->n_rights;
+            WPart *next = side ? nxt->lefts : nxt->rights;
+            Py_ssize_t *n_next = side ? &nxt->n_lefts : &nxt->n_rights;
+            long long *kept = side ? lkept : rkept, *cls = side ? lclass : rclass;
+            for (Py_ssize_t i = 0; i < m; i++) {
+                WPart p = parts[i];
+                double since;
+                WPart keep = p;
+                if (!p.has) {
+                    since = INFINITY;
+                } else {
+                    since = t - p.last;
+                    if (since >= max_interval) keep = (WPart){0, 0.0, 0};
+                }
+                kept[i] = part_number(next, n_next, keep);
+                for (Py_ssize_t j = 0; j < n_played; j++) {
+                    const double *o = rec + j * W_REC;
+                    const double *blk = w + (Py_ssize_t)o[side ? 11 : 10];
+                    const double *nd = blk + p.piece * W_NEED;
+                    double x = since + o[side ? 7 : 5];
+                    long long c = 0;
+                    if (x < nd[0]) {
+                        c = DPCORE_INFEASIBLE;
+                    } else if (x < nd[1]) {
+                        const double *st = blk + (Py_ssize_t)nd[2];
+                        Py_ssize_t cnt = (Py_ssize_t)nd[3];
+                        for (Py_ssize_t q = 0; q < cnt; q++) {
+                            if (x < st[2 * q]) {
+                                c = (long long)st[2 * q + 1] * (side ? 1 : (long long)o[12]);
+                                break;
+                            }
+                        }
+                    }
+                    cls[i * n_played + j] = c;
+                }
+            }
+        }
+        /* the parts each played option makes, then its step */
+        for (Py_ssize_t j = 0; j < n_played; j++) {
+            const double *o = rec + j * W_REC;
+            m_r[j] = m_l[j] = -1;
+            for (int side = 0; side < 2; side++) {
+                double piece = o[side ? 6 : 4];
+                if (piece < 0) continue;
+                double at = t + o[side ? 7 : 5];
+                WPart made = {0, 0.0, 0};
+                if (!(t - at >= max_interval)) made = (WPart){1, at, (long long)piece};
+                if (made.piece < 0 || made.piece >= n_pieces) {
+                    refused = 1;
+                    goto done;
+                }
+                long long num = side ? part_number(nxt->lefts, &nxt->n_lefts, made)
+                                     : part_number(nxt->rights, &nxt->n_rights, made);
+                if (side)
+                    m_l[j] = num;
+                else
+                    m_r[j] = num;
+            }
+            WRow made_row = {(long long)o[3], 1, t};
+            m_row[j] = row_number(nxt->rows, &nxt->n_rows, made_row);
+        }
+        long long n_rl = (long long)nxt->n_rights * nxt->n_lefts, n_lefts = nxt->n_lefts;
+        long long n_next = (long long)nxt->n_rows * n_rl;
+        if (n_next <= 0 || n_next > (1 << 24)) {
+            refused = 1;
+            goto done;
+        }
+        for (Py_ssize_t j = 0; j < n_played; j++) {
+            m_base[j] = m_row[j] * n_rl + (m_r[j] > 0 ? m_r[j] : 0) * n_lefts +
+                        (m_l[j] > 0 ? m_l[j] : 0);
+            m_keeps[j] = (m_r[j] < 0) + 2 * (m_l[j] < 0);
+        }
+        /* the merge (drums._merge_layer) */
+        free(index);
+        free(out_tot);
+        free(out_keys);
+        free(out_came);
+        size_t cap = (size_t)n * (size_t)(n_played + 1) + 1;
+        index = malloc(sizeof(int32_t) * (size_t)n_next);
+        out_tot = malloc(sizeof(double) * cap);
+        out_keys = malloc(sizeof(long long) * cap);
+        out_came = malloc(sizeof(long long) * cap);
+        if (!index || !out_tot || !out_keys || !out_came) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        for (long long i = 0; i < n_next; i++) index[i] = -1;
+        Py_ssize_t n_out = 0;
+        long long n_options = drop_k + 1;
+        long long cur_lefts = cur->n_lefts, cur_rl = (long long)cur->n_rights * cur_lefts;
+        for (Py_ssize_t sid = 0; sid < n; sid++) {
+            long long key = cur->keys[sid];
+            double acc = accs[sid];
+            long long ri = key / cur_rl, hands = key % cur_rl;
+            long long rh = hands / cur_lefts, lh = hands % cur_lefts;
+            const double *row = table + rowcost[ri] * n_cols;
+            long long keep_r = rkept[rh] * n_lefts, keep_l = lkept[lh];
+            long long kept_keys[4] = {0, keep_r, keep_l, keep_r + keep_l};
+            long long here = sid * n_options;
+            const long long *rc = rclass + rh * n_played, *lc = lclass + lh * n_played;
+            for (Py_ssize_t j = 0; j <= n_played; j++) {
+                long long nkey, code;
+                double total;
+                if (j < n_played) {
+                    const double *o = rec + j * W_REC;
+                    long long c = rc[j] + lc[j];
+                    if (c < 0) continue;
+                    long long first = (long long)o[1];
+                    if (c >= (long long)o[9] || first < 0 || first >= n_cols ||
+                        (Py_ssize_t)o[8] + c >= w_len) {
+                        refused = 1;
+                        goto done;
+                    }
+                    nkey = m_base[j] + kept_keys[m_keeps[j]];
+                    total = acc + w[(Py_ssize_t)o[8] + c];
+                    total = total + row[first];
+                    total = total + o[2];
+                    code = here + (long long)o[0];
+                } else { /* dropping every stroke: the row and hands as kept */
+                    nkey = rowkept[ri] * n_rl + kept_keys[3];
+                    total = acc + drop_pen;
+                    code = here + drop_k;
+                }
+                int32_t at = index[nkey];
+                if (at < 0) {
+                    index[nkey] = (int32_t)n_out;
+                    out_keys[n_out] = nkey;
+                    out_tot[n_out] = total;
+                    out_came[n_out] = total < INFINITY ? code : 0;
+                    n_out++;
+                } else if (total < out_tot[at]) {
+                    out_tot[at] = total;
+                    out_came[at] = code;
+                }
+            }
+        }
+        /* the beam: the least-cost states, in their order (bounds.keep_best) */
+        Py_ssize_t n_kept = n_out;
+        if (beam >= 0 && n_out > beam) {
+            free(ranked);
+            ranked = malloc(sizeof(Ranked) * (size_t)n_out);
+            if (!ranked) {
+                PyErr_NoMemory();
+                goto done;
+            }
+            for (Py_ssize_t i = 0; i < n_out; i++) {
+                if (isnan(out_tot[i])) {
+                    refused = 1;
+                    goto done;
+                }
+                ranked[i].cost = out_tot[i];
+                ranked[i].index = i;
+            }
+            qsort(ranked, (size_t)n_out, sizeof(Ranked), ranked_cmp);
+            /* mark the kept ones, then take them in index order */
+            for (Py_ssize_t i = 0; i < n_out; i++) index[out_keys[i]] = 0;
+            for (Py_ssize_t i = 0; i < beam; i++) index[out_keys[ranked[i].index]] = 1;
+            n_kept = 0;
+            for (Py_ssize_t i = 0; i < n_out; i++) {
+                if (index[out_keys[i]]) {
+                    out_keys[n_kept] = out_keys[i];
+                    out_tot[n_kept] = out_tot[i];
+                    out_came[n_kept] = out_came[i];
+                    n_kept++;
+                }
+            }
+        }
+        nxt->keys = malloc(sizeof(long long) * (size_t)(n_kept + 1));
+        nxt->came = malloc(sizeof(long long) * (size_t)(n_kept + 1));
+        double *nacc = malloc(sizeof(double) * (size_t)(n_kept + 1));
+        if (!nxt->keys || !nxt->came || !nacc) {
+            free(nacc);
+            PyErr_NoMemory();
+            goto done;
+        }
+        memcpy(nxt->keys, out_keys, sizeof(long long) * (size_t)n_kept);
+        memcpy(nxt->came, out_came, sizeof(long long) * (size_t)n_kept);
+        memcpy(nacc, out_tot, sizeof(double) * (size_t)n_kept);
+        free(accs);
+        accs = nacc;
+        nxt->n = n_kept;
+        nxt->n_options = n_options;
+    }
+    /* the first state (in layer order) of least objective */
+    WLayer *last = &layers[n_groups];
+    if (last->n == 0) {
+        refused = 1;
+        goto done;
+    }
+    Py_ssize_t end = 0;
+    for (Py_ssize_t i = 1; i < last->n; i++)
+        if (accs[i] < accs[end]) end = i;
+    ks = PyList_New(n_groups);
+    pers = PyList_New(n_groups);
+    states = PyList_New(n_groups);
+    if (!ks || !pers || !states) goto done;
+    Py_ssize_t cur_id = end;
+    for (Py_ssize_t g = n_groups - 1; g >= 0; g--) {
+        WLayer *after = &layers[g + 1], *before = &layers[g];
+        long long code = after->came[cur_id];
+        Py_ssize_t prev_id = (Py_ssize_t)(code / after->n_options);
+        Py_ssize_t k = (Py_ssize_t)(code % after->n_options);
+        long long brl = (long long)before->n_rights * before->n_lefts;
+        WRow brow = before->rows[before->keys[prev_id] / brl];
+        Py_ssize_t r = none_index;
+        if (brow.prev >= 0 && brow.has_t &&
+            PyFloat_AS_DOUBLE(PyList_GET_ITEM(times, g)) - brow.t < rest_s)
+            r = (Py_ssize_t)brow.prev;
+        PyObject *back = PyList_GET_ITEM(backs, g);
+        if (!PyTuple_Check(back) || k >= PyTuple_GET_SIZE(back)) {
+            refused = 1;
+            goto done;
+        }
+        PyObject *opt = PyTuple_GET_ITEM(back, k);
+        if (!PyTuple_CheckExact(opt) || PyTuple_GET_SIZE(opt) < 1) {
+            refused = 1;
+            goto done;
+        }
+        Py_ssize_t n_strokes = PyLong_AsSsize_t(PyTuple_GET_ITEM(opt, 0));
+        if (n_strokes < 0 || n_strokes > 8) {
+            if (!PyErr_Occurred()) refused = 1;
+            goto done;
+        }
+        double per[8] = {0.0};
+        for (Py_ssize_t j = 1; j < PyTuple_GET_SIZE(opt); j++) {
+            PyObject *pm = PyTuple_GET_ITEM(opt, j);
+            if (!PyTuple_CheckExact(pm) || PyTuple_GET_SIZE(pm) != 2) {
+                refused = 1;
+                goto done;
+            }
+            Py_ssize_t m = PyLong_AsSsize_t(PyTuple_GET_ITEM(pm, 0));
+            Py_ssize_t i = PyLong_AsSsize_t(PyTuple_GET_ITEM(pm, 1));
+            if (PyErr_Occurred()) goto done;
+            if (r < 0 || r >= n_trows || m < 0 || m >= n_cols || i < 0 || i >= n_strokes) {
+                refused = 1;
+                goto done;
+            }
+            per[i] = table[r * n_cols + m];
+            r = m;
+        }
+        PyObject *pt = PyTuple_New(n_strokes);
+        if (!pt) goto done;
+        PyList_SET_ITEM(pers, g, pt);
+        for (Py_ssize_t i = 0; i < n_strokes; i++) {
+            PyObject *f = PyFloat_FromDouble(per[i]);
+            if (!f) goto done;
+            PyTuple_SET_ITEM(pt, i, f);
+        }
+        PyObject *kk = PyLong_FromSsize_t(k);
+        if (!kk) goto done;
+        PyList_SET_ITEM(ks, g, kk);
+        long long key = after->keys[cur_id];
+        long long arl = (long long)after->n_rights * after->n_lefts;
+        WRow arow = after->rows[key / arl];
+        WPart aright = after->rights[(key % arl) / after->n_lefts];
+        WPart aleft = after->lefts[key % after->n_lefts];
+        PyObject *st = Py_BuildValue(
+            "(NNNNOO)",
+            arow.prev >= 0 ? PyLong_FromLongLong(arow.prev) : (Py_INCREF(Py_None), Py_None),
+            none_or_float(arow.has_t, arow.t), none_or_float(aright.has, aright.last),
+            none_or_float(aleft.has, aleft.last), PyTuple_GET_ITEM(pieces, aright.piece),
+            PyTuple_GET_ITEM(pieces, aleft.piece));
+        if (!st) goto done;
+        PyList_SET_ITEM(states, g, st);
+        cur_id = prev_id;
+    }
+    result = Py_BuildValue("(OOON)", ks, pers, states, PyFloat_FromDouble(accs[end]));
+done:
+    if (refused && !result && !PyErr_Occurred()) {
+        result = Py_None;
+        Py_INCREF(result);
+    }
+    for (Py_ssize_t g = 0; g < n_bufs; g++) PyBuffer_Release(&bufs[g]);
+    PyBuffer_Release(&table_b);
+    if (layers)
+        for (Py_ssize_t g = 0; g <= n_groups; g++) free_layer(&layers[g]);
+    free(layers);
+    free(bufs);
+    free(accs);
+    free(ranked);
+    free(rclass);
+    free(rkept);
+    free(m_row);
+    free(index);
+    free(out_tot);
+    free(out_keys);
+    free(out_came);
+    Py_XDECREF(ks);
+    Py_XDECREF(pers);
+    Py_XDECREF(states);
+    return result;
+}
+
 /* ------------------------------------------------------------ bass_solve */
 
 /* A bass state (string, fret, hand position) coded as one integer; -1: None. */
@@ -937,6 +1492,7 @@ static PyMethodDef methods[] = {
     {"hand_layer", hand_layer, METH_VARARGS, "One layer of the hand DP (virja.plan.drums)."},
     {"hand_parts", hand_parts, METH_VARARGS, "One hand's parts of a layer (virja.plan.drums)."},
     {"hand_step", hand_step, METH_VARARGS, "One group of the hand DP (virja.plan.drums)."},
+    {"hand_window", hand_window, METH_VARARGS, "A window of the hand DP (virja.plan.drums)."},
     {"bass_solve", bass_solve, METH_VARARGS, "The bass DP (virja.plan.bass.solve)."},
     {NULL, NULL, 0, NULL},
 };

@@ -36,7 +36,7 @@ from virja.events import NoteOn
 from virja.plan import drums as drums_mod
 from virja.plan.bounds import DensityGate, PlanBounds
 from virja.plan.config import PlanConfig
-from virja.plan.timing import align
+from virja.plan.timing import aligned, offsets
 from virja.plan.types import DroppedNote, DropReason, MovedNote, PlannedNote, PlanReport
 from virja.vocab import BassString, Limb, MotionKey, Performer, Piece, as_limb  # noqa: F401  (as_limb: re-exported for the chains)
 
@@ -44,6 +44,7 @@ log = logging.getLogger(__name__)
 
 GROUP_EPS_S = 0.001  # notes this close sound together (one stroke per piece and limb)
 HISTORY = 64  # fixed strokes kept per chain for notes that arrive out of order
+OFFSETS_KEPT = 4096  # alignment offsets kept per chain (kinds times tempi met)
 MAX_REPORTED = 10_000  # dropped and moved notes kept for the report (totals are counted)
 
 
@@ -205,6 +206,12 @@ class Chain(AnyChain, Generic[R]):
         self.last_fixed_t: float | None = None
         self.fixed: list[tuple[float, PlannedNote]] = []  # recent, for notes out of order
         self.gate = DensityGate(ctx.bounds)
+        # what taking a note in reads, looked up once: the chain's config never changes
+        self._timing = ctx.config.timing
+        self._spb_at = ctx.seconds_per_beat_at
+        self._max_pending = ctx.bounds.max_pending
+        # timing.offsets per (kind, seconds per beat) met (a session has a few of each)
+        self._offsets: dict[tuple[str, float], tuple[float, float, float]] = {}
 
     @property
     def pending_count(self) -> int:
@@ -215,11 +222,15 @@ class Chain(AnyChain, Generic[R]):
     def take(self, rec: R) -> None:
         """Align ``rec`` and take it in: dropped past a cap, placed around the fixed
         motions when out of order, else pending (the plan is then solved again)."""
-        cfg = self.ctx.config
         t = rec.note.time_s
-        a = align(cfg.timing, rec.kind, t, rec.known_s, self.ctx.seconds_per_beat_at(t))
-        rec.start, rec.impact, rec.late = a.start, a.impact, a.late
-        if len(self.pending) >= self.ctx.bounds.max_pending:
+        key = (rec.kind, self._spb_at(t))
+        offs = self._offsets.get(key)
+        if offs is None:
+            if len(self._offsets) >= OFFSETS_KEPT:
+                self._offsets.clear()
+            offs = self._offsets[key] = offsets(self._timing, *key)
+        rec.start, rec.impact, rec.late = aligned(offs, t, rec.known_s)
+        if len(self.pending) >= self._max_pending:
             self.ctx.ledger.drop(rec, "planner_full")
             return
         if not self.gate.admit(t):
@@ -229,7 +240,8 @@ class Chain(AnyChain, Generic[R]):
             self.place_out_of_order(rec)
         else:
             self.pending.append(rec)
-            self.min_start = min(self.min_start, rec.start)
+            if rec.start < self.min_start:
+                self.min_start = rec.start
             self.forget_plan()
 
     def forget_plan(self) -> None:

@@ -17,6 +17,7 @@ from virja.plan.chain import Chain, ChainContext, Held, WindowedPlan
 
 # one solved group: the option chosen, the cost it paid, the hand after it
 BassStep = tuple[int, float, bass_mod.BassState]
+CHORDS_KEPT = 4096  # chords' options kept per chain (the pitches met)
 
 
 class BassChain(Chain[Held]):
@@ -26,22 +27,39 @@ class BassChain(Chain[Held]):
         super().__init__(ctx)
         self.state: bass_mod.BassState = None
         self.plan: WindowedPlan[BassStep] = WindowedPlan(ctx.bounds.window_groups)
+        self._setup = ctx.config.bass
+        # bass.chord_options by the chord's pitches, for this chain's setup (which never
+        # changes): looked up without hashing the setup again for every group
+        self._chords: dict[tuple[int, ...], tuple[int, tuple[bass_mod.BassOption, ...]]] = {}
+        self._lowest, self._highest = self._setup.lowest, self._setup.highest
+        self._string_names = tuple(name for name, _open in self._setup.strings)
 
     def held(self, seq: int, note: NoteOn, known_s: float) -> Held:
         """``note`` as this chain holds it: folded into the bass's range (reported
         as moved when it had to be)."""
-        played = bass_mod.fold_into_range(self.ctx.config.bass, note.note)
-        if played != note.note:
-            self.ctx.ledger.move("bass", note, played)
+        played = note.note
+        if not self._lowest <= played <= self._highest:
+            played = bass_mod.fold_into_range(self._setup, played)
+            if played != note.note:
+                self.ctx.ledger.move("bass", note, played)
         return Held(seq, "bass", note, known_s, "pluck", played)
 
     def forget_plan(self) -> None:
         self.plan.forget()
 
     def _group(self, group: list[Held]) -> tuple[list[int], tuple[bass_mod.BassOption, ...]]:
-        pitches = sorted({r.played for r in group}, reverse=True)
-        kept, options = bass_mod.chord_options(self.ctx.config.bass, tuple(pitches))
-        return pitches[:kept], options
+        pitches: tuple[int, ...]
+        if len(group) == 1:
+            pitches = (group[0].played,)
+        else:
+            pitches = tuple(sorted({r.played for r in group}, reverse=True))
+        found = self._chords.get(pitches)
+        if found is None:
+            if len(self._chords) >= CHORDS_KEPT:
+                self._chords.clear()
+            found = self._chords[pitches] = bass_mod.chord_options(self._setup, pitches)
+        kept, options = found
+        return list(pitches[:kept]), options
 
     def fix_groups(self, groups: list[list[Held]], n_groups: int) -> None:
         prepared: dict[int, tuple[list[int], tuple[bass_mod.BassOption, ...]]] = {}
@@ -89,7 +107,7 @@ class BassChain(Chain[Held]):
                 self.drop(rec, "no_double_stop")
                 continue
             s, f = where[rec.played]
-            pluck = bass_mod.motion_key(self.ctx.config.bass.strings[s][0], f, hand)
+            pluck = bass_mod.motion_key(self._string_names[s], f, hand)
             self.emit(
                 rec,
                 limb="right_hand",

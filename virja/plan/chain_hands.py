@@ -401,14 +401,14 @@ class HandsChain(DrumChain):
         for r in hp.extra:  # a third hand piece within the window
             if not self.foot.chick(r):
                 self.drop(r, "three_pieces_at_once")
-        late_rebounds = [r for r in group if r.seq in rebounds]
+        late_rebounds = [r for r in group if r.seq in rebounds] if rebounds else []
         for r in group:
             if r.to_foot and not self.foot.chick(r):
                 self.drop(r, "three_pieces_at_once")
         for si, stroke in enumerate(hp.group.strokes):
             recs = hp.kept[si]
             hand = assignment[si]
-            bounces = [r for k, c in hp.bounces if k == si for r in c]
+            bounces = [r for k, c in hp.bounces if k == si for r in c] if hp.bounces else []
             other = 1 - si
             if (
                 hand is None
@@ -427,6 +427,11 @@ class HandsChain(DrumChain):
                 for r in recs + bounces:
                     if not self.foot.chick(r):
                         self.drop(r, "too_fast")
+                continue
+            if len(recs) == 1:  # most strokes: one note, nothing riding on it
+                self.emit_stroke(recs, stroke.piece, hand, stroke_costs[si])
+                for r in bounces:
+                    self.emit_bounce(r, stroke.piece, hand)
                 continue
             now = [r for r in recs if r.note.time_s - recs[0].note.time_s <= GROUP_EPS_S]
             self.emit_stroke(now, stroke.piece, hand, stroke_costs[si])

@@ -70,12 +70,14 @@ class DrumChain(Chain[DrumHeld]):
         """One stroke for ``recs`` (the same piece at once): shared motion, start and impact."""
         first = recs[0]
         stroke = drum_stroke(piece, limb)
+        limb_, piece_ = stroke.limb, stroke.piece
         for i, rec in enumerate(recs):
-            rec.start, rec.impact, rec.late = first.start, first.impact, first.late
+            if i:  # the first note's own timing is the stroke's
+                rec.start, rec.impact, rec.late = first.start, first.impact, first.late
             self.emit(
                 rec,
-                limb=stroke.limb,
-                piece=stroke.piece,
+                limb=limb_,
+                piece=piece_,
                 string=None,
                 fret=None,
                 motion=stroke,

@@ -24,6 +24,7 @@ Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -282,6 +283,26 @@ def _classed(steps: _Steps, scale: int) -> tuple[_Classed, list[float]]:
     return out, levels
 
 
+def _classed_for(timing: Timing, piece: str | None, scale: int) -> tuple[_Classed, list[float]]:
+    """:func:`_classed` of the steps of a hand striking ``piece`` (:func:`_needs`), made
+    once per timing, piece and scale (shared, read only: every signature with that hand's
+    piece has them)."""
+    global _classed_cache
+    entry = _classed_cache
+    if entry is None or entry[0] is not timing:
+        entry = _classed_cache = (timing, {})
+    key = (piece, scale)
+    found = entry[1].get(key)
+    if found is None:
+        found = entry[1][key] = _classed(_needs(timing, piece)[0], scale)
+    return found
+
+
+_classed_cache: tuple[Timing, dict[tuple[str | None, int], tuple[_Classed, list[float]]]] | None = (
+    None
+)
+
+
 @dataclass(frozen=True, slots=True)
 class _Compiled:
     """Everything about a group's options that does not depend on its time."""
@@ -296,6 +317,11 @@ class _Compiled:
     right_plays: tuple[tuple[float, _Need, _Classed], ...]
     left_plays: tuple[tuple[float, _Need, _Classed], ...]
     pens: tuple[tuple[float, ...], ...]
+    # what ``_dpcore.c``'s ``hand_window`` takes of a group: its options as doubles
+    # (:func:`_native`; None when a piece is not a hand's), and per option (number of
+    # strokes, (motion, stroke index) of each played stroke left hand first): the way back
+    native: array[float] | None
+    back: tuple[tuple[object, ...], ...]
 
 
 def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _Compiled:
@@ -305,6 +331,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
     right_plays = []
     left_plays = []
     pens = []
+    scales: list[int] = []
     for k, assign in enumerate(options(HandGroup(0.0, strokes))):
         played = []
         penalty = 0.0
@@ -341,9 +368,10 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     costs.table[first][last] if len(played) == 2 else 0.0,
                 )
             )
-            l_classed, l_levels = _classed(l_steps, 1)
+            l_classed, l_levels = _classed_for(timing, l_piece, 1)
             n_left = len(l_levels)
-            r_classed, r_levels = _classed(r_steps, n_left)
+            scales.append(n_left)
+            r_classed, r_levels = _classed_for(timing, r_piece, n_left)
             right_plays.append((r_dt, r_reach, r_classed))
             left_plays.append((l_dt, l_reach, l_classed))
             by_class = []
@@ -357,6 +385,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     by_class.append(total)
             pens.append(tuple(by_class))
     assert not opts[-1].played  # the all-drop option is last
+    back = tuple((len(strokes), *((m, i) for _r, m, _p, _dt, i in o.played)) for o in opts)
     return _Compiled(
         tuple(opts),
         tuple(flat),
@@ -364,7 +393,109 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
         tuple(right_plays),
         tuple(left_plays),
         tuple(pens),
+        _native(timing, flat, pens, scales, len(opts) - 1, opts[-1].penalty),
+        back,
     )
+
+
+# the pieces a hand part may hold, numbered for ``_dpcore.c``'s ``hand_window`` (0: none)
+_PIECES: tuple[str | None, ...] = (None, *HAND_PIECES)
+_PIECE_NUMBER = {piece: i for i, piece in enumerate(_PIECES)}
+
+
+def _native(
+    timing: Timing,
+    flat: list[_Played],
+    pens: list[tuple[float, ...]],
+    scales: list[int],
+    drop_k: int,
+    drop_pen: float,
+) -> array[float] | None:
+    """A group's compiled options as ``_dpcore.c``'s ``hand_window`` reads them, one
+    array of doubles (small integers are exact in a double): ``[n_played, drop_k,
+    drop_pen, n_pieces]``; per played option ``[option, first motion, pair cost, last
+    motion, right piece (-1: it does not play), right dt, left piece, left dt, offset of
+    its penalties by class, their number, offset of the right hand's block, of the left
+    hand's, the right hand's class scale (the left hand's number of penalties)]``; then
+    the penalties; then a block per hand piece met (:func:`_block`).  None when a piece
+    is not one of :data:`_PIECES` (the Python loop then runs)."""
+    n = len(flat)
+    head = [float(n), float(drop_k), drop_pen, float(len(_PIECES))]
+    recs: list[float] = []
+    tail: list[float] = []
+    base = len(head) + 13 * n
+    where: dict[str | None, int] = {}  # each hand piece's block, placed once
+    blocks: list[list[float]] = []
+    for played, by_class, scale in zip(flat, pens, scales, strict=True):
+        k, r_piece, r_dt, _rs, _rr, l_piece, l_dt, _ls, _lr, last, _pen, first, pair = played
+        if (r_piece is not None and r_piece not in _PIECE_NUMBER) or (
+            l_piece is not None and l_piece not in _PIECE_NUMBER
+        ):
+            return None
+        recs += [float(k), float(first), pair, float(last)]
+        recs += [-1.0 if r_piece is None else float(_PIECE_NUMBER[r_piece]), r_dt]
+        recs += [-1.0 if l_piece is None else float(_PIECE_NUMBER[l_piece]), l_dt]
+        recs += [float(base + len(tail)), float(len(by_class))]
+        tail += by_class
+        for piece in (r_piece, l_piece):
+            if piece not in where:
+                where[piece] = len(blocks)
+                blocks.append(_block(timing, piece))
+        recs += [float(where[r_piece]), float(where[l_piece]), float(scale)]
+    at = base + len(tail)
+    starts = []
+    for block in blocks:
+        starts.append(float(at))
+        at += len(block)
+    for i in range(n):  # block numbers -> offsets
+        rec = recs[13 * i : 13 * i + 13]
+        recs[13 * i + 10] = starts[int(rec[10])]
+        recs[13 * i + 11] = starts[int(rec[11])]
+    out = array("d", head + recs + tail)
+    for block in blocks:
+        out.extend(block)
+    return out
+
+
+def _block(timing: Timing, piece: str | None) -> list[float]:
+    """What a hand striking ``piece`` (None: not playing) needs, as ``hand_window`` reads
+    it: per previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of
+    its steps from the block's start, their number]``, then the steps ``(time, penalty
+    number)``, the penalties numbered as :func:`_classed` numbers them (0 for none, then
+    as met).  The same for every group: made once per timing and piece."""
+    global _blocks_cache
+    entry = _blocks_cache
+    if entry is None or entry[0] is not timing:
+        entry = _blocks_cache = (timing, {})
+    found = entry[1].get(piece)
+    if found is None:
+        reach = _needs(timing, piece)[1]
+        classed = _classed_for(timing, piece, 1)[0]
+        head: list[float] = []
+        tail: list[float] = []
+        size = 4 * len(_PIECES)
+        for prev in _PIECES:
+            limit, st = classed[prev]
+            head += [reach[prev], limit, float(size + len(tail)), float(len(st))]
+            for time, cls in st:
+                tail += [time, float(cls)]
+        found = entry[1][piece] = head + tail
+    return found
+
+
+_blocks_cache: tuple[Timing, dict[str | None, list[float]]] | None = None
+
+
+def _table_native(costs: DrumCosts) -> array[float]:
+    """The cost table's rows as one array of doubles (``hand_window``'s ``table``)."""
+    global _table_cache
+    entry = _table_cache
+    if entry is None or entry[0] is not costs:
+        entry = _table_cache = (costs, array("d", [c for row in costs.table for c in row]))
+    return entry[1]
+
+
+_table_cache: tuple[DrumCosts, array[float]] | None = None
 
 
 # Compiled options depend only on (costs, timing, strokes), not on the group's time, so
@@ -690,17 +821,46 @@ def solve(
     table = costs.table
     none_row = table[costs.none_row]
     prev0, prev_t0, t_right0, t_left0, p_right0, p_left0 = state
+    compiled_all = [_compiled(costs, timing, group.strokes) for group in groups]
+    core = fastdp.core
+    pr0, pl0 = _PIECE_NUMBER.get(p_right0), _PIECE_NUMBER.get(p_left0)
+    natives = [comp.native for comp in compiled_all]
+    if (
+        core is not None
+        and pr0 is not None
+        and pl0 is not None
+        and None not in natives
+        and all(len(row) == len(table[0]) for row in table)
+    ):  # the whole window compiled (virja/plan/_dpcore.c)
+        whole = core.hand_window(
+            (prev0, prev_t0, t_right0, t_left0, pr0, pl0),
+            [group.time for group in groups],
+            natives,
+            [comp.back for comp in compiled_all],
+            _table_native(costs),
+            len(table[0]),
+            costs.none_row,
+            max_interval,
+            rest_s,
+            -1 if beam is None else beam,
+            _PIECES,
+        )
+        if whole is not None:
+            ks, w_pers, w_states, w_total = whole
+            return HandSolution(
+                tuple(comp.options[k].assign for comp, k in zip(compiled_all, ks, strict=True)),
+                tuple(w_pers),
+                tuple(w_states),
+                w_total,
+            )
     start = _Layer([(prev0, prev_t0)], [(t_right0, p_right0)], [(t_left0, p_left0)], [0], [0], 1)
     layer = start
     accs: list[float] = [0.0]  # least objective reaching each state of the layer
     # per group: the layer after it, with its back-pointers (``_Layer.came``); the
     # per-stroke costs are recomputed once on the way back
     layers: list[_Layer] = []
-    compiled_all = []
-    for group in groups:
+    for group, comp in zip(groups, compiled_all, strict=True):
         t = group.time
-        comp = _compiled(costs, timing, group.strokes)
-        compiled_all.append(comp)
         drop_k = len(comp.options) - 1
         drop_pen = comp.drop_penalty
         stepped = None

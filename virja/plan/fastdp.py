@@ -26,17 +26,37 @@ def source_digest() -> str:
 
 def load() -> ModuleType | None:
     """The built extension if it matches the source next to it, else None."""
+    return load_with_path()[0]
+
+
+def load_with_path() -> tuple[ModuleType | None, str]:
+    """:func:`load`, and which path the planner's DPs take with it, in words: "compiled",
+    or "pure" and why (``VIRJA_PLAN_PURE=1``, not built, a stale build)."""
     if os.environ.get("VIRJA_PLAN_PURE"):
-        return None
+        return None, "pure (VIRJA_PLAN_PURE=1)"
     try:
         module = importlib.import_module("virja.plan._dpcore")
     except ImportError:
-        return None
+        return None, "pure (not built: python tools/build_dpcore.py)"
     try:
         digest = source_digest()
     except OSError:  # installed without the source: trust the build
-        return module
-    return module if getattr(module, "SOURCE_DIGEST", None) == digest else None
+        return module, "compiled"
+    if getattr(module, "SOURCE_DIGEST", None) != digest:
+        return (
+            None,
+            "pure (stale build of another _dpcore.c fell back: python tools/build_dpcore.py)",
+        )
+    return module, "compiled"
 
 
-core: ModuleType | None = load()
+core, _PATH = load_with_path()
+
+
+def path() -> str:
+    """Which path the planner's DPs take in this process: "compiled" (``_dpcore.c``) or
+    "pure" with the reason (what ``virja bench`` and tools/plan_speed.py report, so that
+    a missing or stale build is seen)."""
+    if core is None and _PATH == "compiled":  # set aside in this process (tests do)
+        return "pure (set aside in this process)"
+    return _PATH

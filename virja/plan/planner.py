@@ -70,6 +70,36 @@ def _config(config: PlanConfig | None) -> PlanConfig:
     return _default_config
 
 
+class _TempoTrack:
+    """The session's tempo as the planner knows it: beats seen (the latest
+    MAX_BEATS_KEPT), else ``tempo``, else the default.  Apart from the planner so that
+    its chains can look the tempo up without holding the planner: no reference cycle,
+    so a planner no longer used is freed at once rather than by the cyclic collector
+    (whose pauses were the bench's slowest beats, docs/performance.md)."""
+
+    __slots__ = ("tempo", "times", "spb")
+
+    def __init__(self, tempo: Tempo | None) -> None:
+        self.tempo = tempo
+        self.times: list[float] = []  # sorted; at most MAX_BEATS_KEPT, the latest
+        self.spb: list[float] = []
+
+    def add(self, beat: Beat) -> None:
+        i = bisect.bisect_right(self.times, beat.time_s)
+        self.times.insert(i, beat.time_s)
+        self.spb.insert(i, beat.seconds_per_beat)
+        if len(self.times) > MAX_BEATS_KEPT:  # a daemon runs for hours: keep the latest
+            del self.times[0], self.spb[0]
+
+    def seconds_per_beat_at(self, time_s: float) -> float:
+        i = bisect.bisect_right(self.times, time_s)
+        if i > 0:
+            return self.spb[i - 1]
+        if self.tempo is not None:
+            return self.tempo.seconds_per_beat_at(time_s)
+        return self.spb[0] if self.spb else DEFAULT_SECONDS_PER_BEAT
+
+
 class OnlinePlanner:
     """The scheduler, fed note by note (see the module docstring).
 
@@ -86,11 +116,9 @@ class OnlinePlanner:
     ) -> None:
         self.config = _config(config)
         self.bounds = bounds
-        self._tempo = tempo
-        self._beat_times: list[float] = []  # sorted; at most MAX_BEATS_KEPT, the latest
-        self._beat_spb: list[float] = []
+        self._track = _TempoTrack(tempo)
         self._ledger = Ledger()
-        ctx = ChainContext(self.config, bounds, self._ledger, self.seconds_per_beat_at)
+        ctx = ChainContext(self.config, bounds, self._ledger, self._track.seconds_per_beat_at)
         self._bass = BassChain(ctx)
         right_foot = FootChain(ctx, "right_foot")
         left_foot = FootChain(ctx, "left_foot")
@@ -106,19 +134,10 @@ class OnlinePlanner:
 
     def add_beat(self, beat: Beat) -> None:
         """A beat of the session: its tempo applies from its time on."""
-        i = bisect.bisect_right(self._beat_times, beat.time_s)
-        self._beat_times.insert(i, beat.time_s)
-        self._beat_spb.insert(i, beat.seconds_per_beat)
-        if len(self._beat_times) > MAX_BEATS_KEPT:  # a daemon runs for hours: keep the latest
-            del self._beat_times[0], self._beat_spb[0]
+        self._track.add(beat)
 
     def seconds_per_beat_at(self, time_s: float) -> float:
-        i = bisect.bisect_right(self._beat_times, time_s)
-        if i > 0:
-            return self._beat_spb[i - 1]
-        if self._tempo is not None:
-            return self._tempo.seconds_per_beat_at(time_s)
-        return self._beat_spb[0] if self._beat_spb else DEFAULT_SECONDS_PER_BEAT
+        return self._track.seconds_per_beat_at(time_s)
 
     def add_note(self, performer: Performer, note: NoteOn, *, now_s: float) -> None:
         """A note for ``performer`` that sounds at ``note.time_s``, known since ``now_s``."""

@@ -42,7 +42,13 @@ def align(
     the full anticipation (``known_s > time - anticipation``): compressed, it
     starts at ``known_s`` and strikes at ``max(time, known_s + min_anticipation)``.
     """
-    a, shortest, allowed = _offsets(timing, kind, seconds_per_beat)
+    return aligned(_offsets(timing, kind, seconds_per_beat), time_s, known_s)
+
+
+def aligned(offsets: tuple[float, float, float], time_s: float, known_s: float) -> Alignment:
+    """:func:`align` given its kind's and tempo's :func:`offsets` (the chains keep
+    those per kind and tempo, and align every note they take in with this)."""
+    a, shortest, allowed = offsets
     start = time_s - a
     if known_s <= start:
         return _new(Alignment, (start, time_s, False))
@@ -75,8 +81,14 @@ def _offsets(timing: Timing, kind: str, seconds_per_beat: float) -> tuple[float,
     if found is None:
         if len(entry[1]) >= _OFFSETS_LIMIT:
             entry[1].clear()
-        shortest = timing.get(kind).min_anticipation_s
-        # played at once: the stroke is the norm
-        allowed = shortest if timing.immediate else 0.0
-        found = entry[1][key] = (anticipation_s(timing, kind, seconds_per_beat), shortest, allowed)
+        found = entry[1][key] = offsets(timing, kind, seconds_per_beat)
     return found
+
+
+def offsets(timing: Timing, kind: str, seconds_per_beat: float) -> tuple[float, float, float]:
+    """:func:`anticipation_s`, ``min_anticipation_s`` and what :func:`align` allows a
+    note played at once (the shortest stroke, else 0)."""
+    shortest = timing.get(kind).min_anticipation_s
+    # played at once: the stroke is the norm
+    allowed = shortest if timing.immediate else 0.0
+    return (anticipation_s(timing, kind, seconds_per_beat), shortest, allowed)

@@ -48,9 +48,10 @@ from typing import Any
 
 import numpy as np
 
-from virja.motion import quat
+from virja.geometry import GEOMETRY, DrumKit
+from virja.motion import drummer_clear, quat
 from virja.motion.clip import Clip
-from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
+from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
 from virja.vocab import CYMBAL_PIECES
 
 _SK = SKELETON
@@ -331,9 +332,14 @@ class DrummerHands:
     """The strokes of the drummer's two hands and the arm poses made from them."""
 
     def __init__(
-        self, root: np.ndarray, idle_local: np.ndarray, settings: HandSettings | None = None
+        self,
+        root: np.ndarray,
+        idle_local: np.ndarray,
+        settings: HandSettings | None = None,
+        kit: DrumKit = GEOMETRY.kit,
     ) -> None:
         self.settings = settings or HandSettings.load()
+        self._kit = kit
         self._root = np.asarray(root, dtype=np.float64)
         self._idle = np.asarray(idle_local, dtype=np.float64)
         p, r = _SK.fk(self._idle, self._root)
@@ -369,6 +375,12 @@ class DrummerHands:
         # and strokes landed (what a freeze cuts)
         self._base: dict[str, _Base | None] = dict.fromkeys(HANDS)
         self._lists: dict[str, tuple[Any, ...] | None] = dict.fromkeys(HANDS)
+        # the two tracks kept apart (virja.motion.drummer_clear): each hand's detours,
+        # the key tracks they were found on, and the last frame drawn (never changed)
+        self._detours: dict[str, list[drummer_clear.Detour]] = {h: [] for h in HANDS}
+        self._lifts: dict[str, list[drummer_clear.Detour]] = {h: [] for h in HANDS}
+        self._detour_src: tuple[_Keys | None, ...] | None = None
+        self._drawn = -math.inf
 
     @property
     def enabled(self) -> bool:
@@ -465,6 +477,7 @@ class DrummerHands:
         :meth:`_yield`): if a rebuilt track differs there, the old one is frozen up to
         ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
         live = drawn > -math.inf
+        self._drawn = max(self._drawn, drawn)
         olds = {h: (self.keys(h) if live else None, self._lists[h]) for h in HANDS}
         apply()
         for h in HANDS:
@@ -496,6 +509,8 @@ class DrummerHands:
                 del self._strokes[h][:k]
                 del self._ids[h][:k]
                 self._keys[h] = None
+            self._detours[h] = [d for d in self._detours[h] if d.t3 >= horizon]
+            self._lifts[h] = [d for d in self._lifts[h] if d.t3 >= horizon]
             base = self._base[h]
             if base is not None:  # keys long past: the last before the horizon is enough
                 k = max(bisect.bisect_right(base.pt, horizon) - 1, 0)
@@ -826,10 +841,60 @@ class DrummerHands:
     # ------------------------------------------------------------------ output
 
     def targets(self, hand: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Wrist position (m, 3), hand world rotation (m, 4) and elbow hint (m, 3) at ``times``."""
+        """Wrist position (m, 3), hand world rotation (m, 4) and elbow hint (m, 3) at ``times``:
+        the hand's own track, bent around the other stick and the kit (:meth:`_clear`)."""
+        self._clear()
+        t = np.asarray(times, dtype=np.float64)
+        wrist, rot, elbow = self._track(hand, t)
+        return wrist + drummer_clear.offsets(self._detours[hand], t), rot, elbow
+
+    def _stick(self, hand: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The wrist and the stick's butt and tip, each (m, 3), on the hand's track with
+        its detours."""
+        wrist, rot, _elbow = self._track(hand, times)
+        wrist = wrist + drummer_clear.offsets(self._detours[hand], times)
+        grip = wrist + quat.rotate(rot, self._grip_off[hand])
+        axis = quat.rotate(rot, STICK_AXIS_LOCAL)
+        return wrist, grip - STICK_BUTT_M * axis, grip + STICK_TIP_M * axis
+
+    def _clear(self) -> None:
+        """Find the detours that keep the two sticks apart and off the kit, once per
+        change of either track: those begun by the last frame drawn stay (cut short
+        before an impact of their hand now after it), later ones are found anew."""
+        src = tuple(self.keys(h) if self.has_strokes(h) else None for h in HANDS)
+        old = self._detour_src
+        if old is not None and all(a is b for a, b in zip(src, old, strict=True)):
+            return
+        self._detour_src = src
+        floor = self._drawn
+        for h in HANDS:
+            for kept in (self._detours, self._lifts):
+                kept[h] = [_cut_detour(d, self._times[h], floor) for d in kept[h] if d.t0 <= floor]
+        known = [k for k in src if k is not None]
+        if not known:
+            return
+        impacts = [list(self._times[h]) for h in HANDS]
+        last = max((ts[-1] for ts in impacts if ts), default=-math.inf)
+        first = min(float(k.t[0]) for k in known)
+        span = (max(first, floor), last + 0.5)
+        if not all(math.isfinite(x) for x in span) or span[1] <= span[0]:
+            return
+        for _ in range(3):  # a detour may bring a stick near something else: again
+            fns = [
+                (lambda ts, h=h: self._stick(h, ts)) if k is not None else None
+                for h, k in zip(HANDS, src, strict=True)
+            ]
+            moves, lifts = drummer_clear.detours(fns, impacts, self._kit, span, floor)
+            if not any(moves) and not any(lifts):
+                break
+            for h, found, up in zip(HANDS, moves, lifts, strict=True):
+                self._detours[h] = sorted(self._detours[h] + found, key=lambda d: d.t0)
+                self._lifts[h] = sorted(self._lifts[h] + up, key=lambda d: d.t0)
+
+    def _track(self, hand: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`targets` on the hand's own key track (no detours)."""
         k = self.keys(hand)
         assert k is not None
-        t = np.asarray(times, dtype=np.float64)
         i0, i1, u = _shaped(k.t, k.profile, t, k.end_t)
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
@@ -850,6 +915,8 @@ class DrummerHands:
         lever = STICK_TIP_M + float(np.linalg.norm(off))
         sin_a = -d[:, 1]  # the stick's slope below the horizontal
         rise = (1.0 - s.wrist_share) * lift
+        if self._lifts[hand]:  # the tip over a piece it would go through (_clear)
+            rise = rise + drummer_clear.offsets(self._lifts[hand], t)[:, 1]
         theta = np.arcsin(np.clip(rise / lever - sin_a, -1.0, math.sin(math.radians(60.0))))
         theta = theta + np.arcsin(np.clip(sin_a, -1.0, 1.0))
         rot = quat.multiply(quat.from_axis_angle(axis, theta), rot)
@@ -887,6 +954,20 @@ class DrummerHands:
 
     def joint_index(self, hand: str) -> np.ndarray:
         return self._joints[hand]
+
+
+def _cut_detour(
+    d: drummer_clear.Detour, impacts: list[float], drawn: float
+) -> drummer_clear.Detour:
+    """A detour begun by ``drawn``, back to zero before its hand's first impact after
+    ``drawn`` (a stroke added since): unchanged at and before ``drawn``."""
+    k = bisect.bisect_right(impacts, max(drawn, d.t0))
+    if k == len(impacts) or impacts[k] >= d.t3 + drummer_clear.BEFORE_IMPACT_S:
+        return d
+    imp = impacts[k]
+    t2 = max(drawn, d.t1, min(d.t2, imp - 2 * drummer_clear.BEFORE_IMPACT_S))
+    t3 = min(max(t2 + 1e-3, imp - drummer_clear.BEFORE_IMPACT_S), imp)
+    return drummer_clear.Detour(d.t0, d.t1, t2, max(t3, t2 + 1e-4), d.vec)
 
 
 def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:

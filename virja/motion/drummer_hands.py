@@ -87,6 +87,7 @@ _YIELD_SHARE = 0.6  # out of the way within this share of the time to the other'
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
 _SQUEEZED, _RAMP = 4, 0.2
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
+_SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
 _REACH_MIN_S = 0.04
@@ -275,7 +276,11 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
         1.0 - (1.0 - u) ** _RISE_LEAD,
         np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
     )
-    lag = np.where(profile == _MOVE_OFF_HIHAT, u**_HIHAT_LAG, u**_DROP_LAG)
+    lag = np.where(
+        profile == _MOVE_OFF_HIHAT,
+        u**_HIHAT_LAG,
+        np.where(profile == _SQUEEZED, u**_SQUEEZED_LAG, u**_DROP_LAG),
+    )
     return np.where(rise > 0, lead, lag)
 
 

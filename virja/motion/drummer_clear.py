@@ -68,6 +68,10 @@ RAMP_SPEED_M_S = 3.0  # the peak speed a detour adds (1.5 amplitude / ramp)
 # downstroke's tip comes in at 5-10 m/s); 3.0 left 6 of 22 hi-hat runs of MMA Swing1
 # at 240 bpm unmade (the tip under the hi-hat 25 ms after its impact, 85 ms to the snare)
 LIFT_SPEED_M_S = 10.0
+# a lift starts at its hand's impact (the rebound) and ends this long before the next
+# (the tip under the snare's head 25 ms before its own stroke on it, coming in low
+# from the hi-hat: GMD punk 140 at 2.12 s)
+LIFT_BEFORE_S = 0.008
 SAMPLE_S = 1.0 / 240.0
 # a detour is made only if the wrist then moves no more between two 30 fps frames than
 # it did, or at most JUMP_OK_M, and no faster than it did, or at most SPEED_OK_M_S (a
@@ -181,13 +185,14 @@ def _window(
     speed: float = RAMP_SPEED_M_S,
     pad: float = 0.0,
     after: float = AFTER_IMPACT_S,
+    before: float = BEFORE_IMPACT_S,
 ) -> Window | None:
     """(t0, t1, t2, t3) of a detour of amplitude ``amp`` held over [t_in, t_out],
     between the hand's impacts (``impacts`` sorted) and after ``floor``; None when no
     impact-free span holds it or its ramps would be too fast."""
     k = bisect.bisect_right(impacts, t_in)
     lo = max((impacts[k - 1] + after) if k else -np.inf, floor)
-    hi = impacts[k] - BEFORE_IMPACT_S if k < len(impacts) else np.inf
+    hi = impacts[k] - before if k < len(impacts) else np.inf
     if k < len(impacts) and impacts[k] <= t_out:
         return None  # an impact inside the conflict: nothing to bend
     need = 1.5 * amp / speed
@@ -359,7 +364,15 @@ def detours(
             for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):
                 amp = SURFACE_CLEAR_M - float(hgt[i : j + 1].min())
                 w = _window(
-                    impacts[h], float(t[i]), float(t[j]), floor, amp, LIFT_SPEED_M_S, after=0.0
+                    impacts[h],
+                    float(t[i]),
+                    float(t[j]),
+                    floor,
+                    amp,
+                    LIFT_SPEED_M_S,
+                    0.0,
+                    0.0,
+                    LIFT_BEFORE_S,
                 )
                 if w is not None:  # the wrist stays: no jump, no speed added
                     lifts[h].append(Detour(w[0], w[1], w[2], w[3], np.array([0.0, amp, 0.0])))

@@ -9,14 +9,14 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **keys**: for each stroke a *backswing* key (the next piece's impact pose
   with the stick raised) ``down`` seconds before the impact and the impact key
   itself; after the impact the stick rebounds to a *hover* over the piece just
-  struck and waits there; the hand leaves for the next piece only when it must
-  (``distance / move_speed`` before the backswing key, or at once when the
-  time is short); after ``rest_after_s`` without a stroke it goes to the
+  struck and waits there; the hand leaves for the next piece ``move_early``
+  times ``distance / move_speed`` before the impact, slower than it must (or at
+  once when the time is short); after ``rest_after_s`` without a stroke it goes to the
   relaxed ready pose and comes back in time for the next.  A move the plan
   leaves less time than that goes at even speed between short ramps
   (``_SQUEEZED``), and the stick takes part of it: at the impacts on either side
   the hand and stick are turned about the tip so the wrist sits toward the other
-  piece (``reach_*``, :meth:`DrummerHands._reached`; not where the hands cross);
+  piece (``reach_*``, :meth:`DrummerHands._reached`, also where the hands cross);
   a hand over a cymbal (or on the spot of a drum) that the other hand strikes
   next gets out of its way low and sideways (:meth:`DrummerHands._yield`).
 - **lift**: velocity sets the stick tip's height above the surface (not a
@@ -29,6 +29,9 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **profiles**: into an impact the stick accelerates (u^2), out of it it
   decelerates, every other segment eases in and out (smoothstep); the pose
   is interpolated between keys (grip and elbow lerp, hand rotation slerp).
+- **apart**: the two hands' tracks are sampled together and bent around each
+  other and the kit where a stick would go through the other or a tip under a
+  piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).
 - **arm**: each frame the arm is solved by two-bone IK from the fixed shoulder
   to the wrist, the elbow toward the interpolated authored elbow, the hand at
   its world rotation.  At the impact key the pose is the clip's own, so contact
@@ -91,12 +94,7 @@ _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
 _REACH_MIN_S = 0.04
-_CROSSED_S = 0.25  # see DrummerHands._crossed
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
-# a move with time to spare takes up to this many times its time at move_speed_m_s (the
-# hand leaves sooner and goes slower): its smoothstep peak and a downstroke at its end
-# added up to 15-16 cm a frame at 30 fps (GMD rock-prog 190 at 11.94 s, rock 180 at 7.3 s)
-_EARLY = 1.0
 
 
 @dataclass(frozen=True)
@@ -118,6 +116,7 @@ class HandSettings:
     rebound_share: float = 0.3
     rebound_max_s: float = 0.12
     move_speed_m_s: float = 2.0
+    move_early: float = 2.0
     rest_after_s: float = 2.0
     rest_move_s: float = 0.5
     reach_speed_m_s: float = 2.5
@@ -607,36 +606,22 @@ class DrummerHands:
         return out
 
     def _reached(
-        self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float, t: float
+        self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float
     ) -> np.ndarray:
         """``row`` reaching toward ``here`` (a row) when the wrist's way between them in
         ``span`` s is longer than ``reach_speed_m_s`` allows: by ``share`` of the excess,
-        at most ``reach_max_m``."""
+        at most ``reach_max_m``.  Also where the hands cross (a left hand on the ride
+        while the right plays the hi-hat): a stick turned about its tip there swept
+        through the other stick (MMA Swing1 at 300 bpm) and was withheld until the
+        tracks were kept apart as paths (:meth:`_clear`); withheld, the crossed hand's
+        wrist went the whole way (0.6 m in 164 ms: 16.7 cm a frame at 30 fps, MMA
+        Swing1 at 240 bpm)."""
         s = self.settings
         a, b = self._wrist(hand, row), self._wrist(hand, here)
         excess = float(np.linalg.norm(a - b)) - s.reach_speed_m_s * max(span, 0.0)
-        if excess <= 0.0 or self._crossed(hand, row, t):
+        if excess <= 0.0:
             return row
         return self._reach(hand, row, b, min(share * excess, s.reach_max_m))
-
-    def _crossed(self, hand: str, row: np.ndarray, t: float) -> bool:
-        """Whether the other hand strikes on ``hand``'s side of ``row``'s tip within
-        ``_CROSSED_S`` of ``t`` (the hands cross, as a left hand on the ride while the
-        right plays the snare), or within 25 cm of it (both on the ride): there a stick turned about its tip swept through the
-        other stick (MMA Swing1 at 300 bpm: 5 -> 7 runs), so the wrist goes the whole way."""
-        other = HANDS[1 - HANDS.index(hand)]
-        side = self._shoulder[hand] - self._shoulder[other]
-        side[1] = 0.0
-        times = self._times[other]
-        lo = bisect.bisect_left(times, t - _CROSSED_S)
-        hi = bisect.bisect_right(times, t + _CROSSED_S)
-        tip = _tip(row)
-        for k in range(lo, hi):
-            pose = self._strokes[other][k][1]
-            tip_o = _tip(np.concatenate([pose.grip, pose.rot]))
-            if float((tip_o - tip) @ side) > 0.0 or np.linalg.norm(tip_o - tip) < 0.25:
-                return True  # crossed, or both on one piece
-        return False
 
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
@@ -719,7 +704,7 @@ class DrummerHands:
             room = t - cut
             # a far move with little time: the stick takes part of it (_reached); at this
             # impact the wrist still sits toward where it comes from ...
-            target = self._reached(hand, target, here, room, 1.0, t)
+            target = self._reached(hand, target, here, room, 1.0)
             # ... and already toward the next piece, when that stroke is known in time
             # and its move will be short of time too: from the start when it is known
             # before this move begins, else re-aimed from when it is known
@@ -728,7 +713,7 @@ class DrummerHands:
             if j is not None and strokes[j][0] < t - _REACH_MIN_S:
                 nxt_pose = strokes[j][1]
                 nxt_row = np.concatenate([nxt_pose.grip, nxt_pose.rot, nxt_pose.elbow])
-                reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5, t)
+                reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5)
             down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
             down = min(down, 0.5 * room) if room > 0 else 0.0
             rise = min(2 * down + 0.05, 0.5 * gap)
@@ -738,7 +723,7 @@ class DrummerHands:
                 travel = max(travel, s.rest_move_s)
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:  # ... or a little before: a slower move, when there is time
-                leave = max(t - _EARLY * travel, cut + 1e-4)
+                leave = max(t - s.move_early * travel, cut + 1e-4)
             if j is not None and strokes[j][0] <= max(leave, cut):
                 target = reached  # known before the hand leaves: the whole way to it
             if leave > cut + 1e-4:

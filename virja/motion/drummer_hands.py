@@ -481,6 +481,8 @@ class DrummerHands:
         :meth:`_yield`): if a rebuilt track differs there, the old one is frozen up to
         ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
         live = drawn > -math.inf
+        if live:  # the frames drawn so far were drawn with the detours of the tracks then
+            self._clear()
         self._drawn = max(self._drawn, drawn)
         olds = {h: (self.keys(h) if live else None, self._lists[h]) for h in HANDS}
         apply()

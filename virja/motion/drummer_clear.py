@@ -10,18 +10,20 @@ surface inside its rim, one hand's track is bent away by a *detour*: a smooth of
 of the whole hand (wrist, grip and stick moved together) that is zero at every
 impact of that hand, ramps in and out with smoothstep and holds over the conflict.
 
-- **stick against stick**: the hand with more free time around the conflict (the
-  longer way to its own impacts on either side) moves, away from the other stick
-  along the line between the two sticks' closest points, to a clearance of
-  ``STICK_CLEAR_M``;
+- **stick against stick**: where the sticks come within ``STICK_TRIGGER_M``, one
+  hand moves: across the sticks to ``STICK_CLEAR_M``, or up over the other stick,
+  or back along its own; the least offset that fits between that hand's impacts,
+  keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
+  into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
   wrist stays where it is) until the tip is ``SURFACE_CLEAR_M`` over the surface:
   over the rim, not through the cymbal.  (Moving the whole hand up instead added up
   to 2.4 cm to the 30 fps jumps of the fast hi-hat-to-snare moves it fixed.)
 
-A detour never starts before a frame already drawn (``drawn``), so a change of plan
+A detour never starts before a frame already drawn (``floor``), so a change of plan
 never changes a frame shown; one that would have to ramp faster than ``RAMP_SPEED_M_S``
-(peak, smoothstep: 1.5 x its amplitude over its ramp) is not made.
+(``LIFT_SPEED_M_S`` for a lift; peak, smoothstep: 1.5 x its amplitude over its ramp)
+is not made.
 
 Pure functions over arrays: (n,) times, (n, 3) metres; detours as :class:`Detour`.
 """
@@ -36,8 +38,8 @@ import numpy as np
 
 from virja.geometry import Cymbal, Drum, DrumKit
 
-STICK_RADIUS_M = 0.007  # as virja.motion.drummer_report measures
-# two sticks nearer than this (closest points of their axes) are moved apart to it
+# two sticks nearer than this (closest points of their axes; virja.motion.
+# drummer_report counts them touching under 14 mm, two stick radii) are moved apart
 STICK_TRIGGER_M = 0.022
 STICK_CLEAR_M = 0.035
 # ... and a detour is made only if it keeps them this far apart over its whole window;
@@ -45,11 +47,12 @@ STICK_CLEAR_M = 0.035
 STICK_APART_M = 0.018
 STICK_MORE_M = 0.02
 # a hand lifted over the other stick, or pulled back along its own stick out of the
-# other's way (a left hand down from the crash to the snare through the crossed right
-# stick rising over the hi-hat: GMD hiphop 110 at 6.74 s), when across them fails
+# other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these;
+# its left hand down from the crash to the snare through the crossed right stick at
+# 6.74 s is not cleared by 14 cm either: it would have to go round the stick's end)
 UP_M = (0.04, 0.07, 0.1, 0.14)
 # a tip more than SURFACE_TRIGGER_M under a piece's top inside its rim (+ a margin) is
-# moved out along the piece's normal to SURFACE_CLEAR_M over it
+# lifted (the stick turned up about the wrist) to SURFACE_CLEAR_M over it
 SURFACE_TRIGGER_M = 0.002
 SURFACE_CLEAR_M = 0.012
 RIM_MARGIN_M = 0.01
@@ -65,8 +68,9 @@ RAMP_MAX_S = 0.08  # ramps no longer than this (a detour is local)
 HOLD_PAD_S = (0.025, 0.06, 0.12)
 RAMP_SPEED_M_S = 3.0  # the peak speed a detour adds (1.5 amplitude / ramp)
 # ... a lift's at the tip: a stick flicks up off a cymbal faster than a hand moves (a
-# downstroke's tip comes in at 5-10 m/s); 3.0 left 6 of 22 hi-hat runs of MMA Swing1
-# at 240 bpm unmade (the tip under the hi-hat 25 ms after its impact, 85 ms to the snare)
+# downstroke's tip comes in at 5-10 m/s); 6 and 8 m/s left 12 and 4 of the 22 hi-hat
+# runs of MMA Swing1 at 240 bpm unmade (the tip under the hi-hat 20 ms after its
+# impact, 85 ms before the snare), 10 none
 LIFT_SPEED_M_S = 10.0
 # a lift starts at its hand's impact (the rebound) and ends this long before the next
 # (the tip under the snare's head 25 ms before its own stroke on it, coming in low

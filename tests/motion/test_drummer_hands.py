@@ -142,6 +142,10 @@ def test_settings_load_and_errors(tmp_path: Path) -> None:
     bad.write_text(text.replace("speed_m_s = 2.0", "speed_m_s = 0"), encoding="utf-8")
     with pytest.raises(ConfigError, match="move.speed_m_s must be a number > 0"):
         HandSettings.load(bad)
+    assert HandSettings.load().move_early == 2.0
+    bad.write_text(text.replace("early = 2.0", "early = 0.5"), encoding="utf-8")
+    with pytest.raises(ConfigError, match="move.early must be a number >= 1"):
+        HandSettings.load(bad)
 
 
 def test_a_side_stick_only_tilts_and_a_rim_shot_is_a_full_stroke(library: MotionLibrary) -> None:

@@ -9,14 +9,14 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **keys**: for each stroke a *backswing* key (the next piece's impact pose
   with the stick raised) ``down`` seconds before the impact and the impact key
   itself; after the impact the stick rebounds to a *hover* over the piece just
-  struck and waits there; the hand leaves for the next piece only when it must
-  (``distance / move_speed`` before the backswing key, or at once when the
-  time is short); after ``rest_after_s`` without a stroke it goes to the
+  struck and waits there; the hand leaves for the next piece ``move_early``
+  times ``distance / move_speed`` before the impact, slower than it must (or at
+  once when the time is short); after ``rest_after_s`` without a stroke it goes to the
   relaxed ready pose and comes back in time for the next.  A move the plan
   leaves less time than that goes at even speed between short ramps
   (``_SQUEEZED``), and the stick takes part of it: at the impacts on either side
   the hand and stick are turned about the tip so the wrist sits toward the other
-  piece (``reach_*``, :meth:`DrummerHands._reached`; not where the hands cross);
+  piece (``reach_*``, :meth:`DrummerHands._reached`, also where the hands cross);
   a hand over a cymbal (or on the spot of a drum) that the other hand strikes
   next gets out of its way low and sideways (:meth:`DrummerHands._yield`).
 - **lift**: velocity sets the stick tip's height above the surface (not a
@@ -29,6 +29,9 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **profiles**: into an impact the stick accelerates (u^2), out of it it
   decelerates, every other segment eases in and out (smoothstep); the pose
   is interpolated between keys (grip and elbow lerp, hand rotation slerp).
+- **apart**: the two hands' tracks are sampled together and bent around each
+  other and the kit where a stick would go through the other or a tip under a
+  piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).
 - **arm**: each frame the arm is solved by two-bone IK from the fixed shoulder
   to the wrist, the elbow toward the interpolated authored elbow, the hand at
   its world rotation.  At the impact key the pose is the clip's own, so contact
@@ -48,9 +51,10 @@ from typing import Any
 
 import numpy as np
 
-from virja.motion import quat
+from virja.geometry import GEOMETRY, DrumKit
+from virja.motion import drummer_clear, quat
 from virja.motion.clip import Clip
-from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
+from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
 from virja.vocab import CYMBAL_PIECES
 
 _SK = SKELETON
@@ -86,15 +90,11 @@ _YIELD_SHARE = 0.6  # out of the way within this share of the time to the other'
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
 _SQUEEZED, _RAMP = 4, 0.2
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
+_SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
 _REACH_MIN_S = 0.04
-_CROSSED_S = 0.25  # see DrummerHands._crossed
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
-# a move with time to spare takes up to this many times its time at move_speed_m_s (the
-# hand leaves sooner and goes slower): its smoothstep peak and a downstroke at its end
-# added up to 15-16 cm a frame at 30 fps (GMD rock-prog 190 at 11.94 s, rock 180 at 7.3 s)
-_EARLY = 1.0
 
 
 @dataclass(frozen=True)
@@ -116,6 +116,7 @@ class HandSettings:
     rebound_share: float = 0.3
     rebound_max_s: float = 0.12
     move_speed_m_s: float = 2.0
+    move_early: float = 2.0
     rest_after_s: float = 2.0
     rest_move_s: float = 0.5
     reach_speed_m_s: float = 2.5
@@ -274,7 +275,11 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
         1.0 - (1.0 - u) ** _RISE_LEAD,
         np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
     )
-    lag = np.where(profile == _MOVE_OFF_HIHAT, u**_HIHAT_LAG, u**_DROP_LAG)
+    lag = np.where(
+        profile == _MOVE_OFF_HIHAT,
+        u**_HIHAT_LAG,
+        np.where(profile == _SQUEEZED, u**_SQUEEZED_LAG, u**_DROP_LAG),
+    )
     return np.where(rise > 0, lead, lag)
 
 
@@ -331,9 +336,14 @@ class DrummerHands:
     """The strokes of the drummer's two hands and the arm poses made from them."""
 
     def __init__(
-        self, root: np.ndarray, idle_local: np.ndarray, settings: HandSettings | None = None
+        self,
+        root: np.ndarray,
+        idle_local: np.ndarray,
+        settings: HandSettings | None = None,
+        kit: DrumKit = GEOMETRY.kit,
     ) -> None:
         self.settings = settings or HandSettings.load()
+        self._kit = kit
         self._root = np.asarray(root, dtype=np.float64)
         self._idle = np.asarray(idle_local, dtype=np.float64)
         p, r = _SK.fk(self._idle, self._root)
@@ -369,6 +379,12 @@ class DrummerHands:
         # and strokes landed (what a freeze cuts)
         self._base: dict[str, _Base | None] = dict.fromkeys(HANDS)
         self._lists: dict[str, tuple[Any, ...] | None] = dict.fromkeys(HANDS)
+        # the two tracks kept apart (virja.motion.drummer_clear): each hand's detours,
+        # the key tracks they were found on, and the last frame drawn (never changed)
+        self._detours: dict[str, list[drummer_clear.Detour]] = {h: [] for h in HANDS}
+        self._lifts: dict[str, list[drummer_clear.Detour]] = {h: [] for h in HANDS}
+        self._detour_src: tuple[_Keys | None, ...] | None = None
+        self._drawn = -math.inf
 
     @property
     def enabled(self) -> bool:
@@ -465,6 +481,9 @@ class DrummerHands:
         :meth:`_yield`): if a rebuilt track differs there, the old one is frozen up to
         ``drawn`` (:class:`_Base`) and the strokes after it built on from it."""
         live = drawn > -math.inf
+        if live:  # the frames drawn so far were drawn with the detours of the tracks then
+            self._clear()
+        self._drawn = max(self._drawn, drawn)
         olds = {h: (self.keys(h) if live else None, self._lists[h]) for h in HANDS}
         apply()
         for h in HANDS:
@@ -496,6 +515,8 @@ class DrummerHands:
                 del self._strokes[h][:k]
                 del self._ids[h][:k]
                 self._keys[h] = None
+            self._detours[h] = [d for d in self._detours[h] if d.t3 >= horizon]
+            self._lifts[h] = [d for d in self._lifts[h] if d.t3 >= horizon]
             base = self._base[h]
             if base is not None:  # keys long past: the last before the horizon is enough
                 k = max(bisect.bisect_right(base.pt, horizon) - 1, 0)
@@ -587,36 +608,22 @@ class DrummerHands:
         return out
 
     def _reached(
-        self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float, t: float
+        self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float
     ) -> np.ndarray:
         """``row`` reaching toward ``here`` (a row) when the wrist's way between them in
         ``span`` s is longer than ``reach_speed_m_s`` allows: by ``share`` of the excess,
-        at most ``reach_max_m``."""
+        at most ``reach_max_m``.  Also where the hands cross (a left hand on the ride
+        while the right plays the hi-hat): a stick turned about its tip there swept
+        through the other stick (MMA Swing1 at 300 bpm) and was withheld until the
+        tracks were kept apart as paths (:meth:`_clear`); withheld, the crossed hand's
+        wrist went the whole way (0.6 m in 164 ms: 16.7 cm a frame at 30 fps, MMA
+        Swing1 at 240 bpm)."""
         s = self.settings
         a, b = self._wrist(hand, row), self._wrist(hand, here)
         excess = float(np.linalg.norm(a - b)) - s.reach_speed_m_s * max(span, 0.0)
-        if excess <= 0.0 or self._crossed(hand, row, t):
+        if excess <= 0.0:
             return row
         return self._reach(hand, row, b, min(share * excess, s.reach_max_m))
-
-    def _crossed(self, hand: str, row: np.ndarray, t: float) -> bool:
-        """Whether the other hand strikes on ``hand``'s side of ``row``'s tip within
-        ``_CROSSED_S`` of ``t`` (the hands cross, as a left hand on the ride while the
-        right plays the snare), or within 25 cm of it (both on the ride): there a stick turned about its tip swept through the
-        other stick (MMA Swing1 at 300 bpm: 5 -> 7 runs), so the wrist goes the whole way."""
-        other = HANDS[1 - HANDS.index(hand)]
-        side = self._shoulder[hand] - self._shoulder[other]
-        side[1] = 0.0
-        times = self._times[other]
-        lo = bisect.bisect_left(times, t - _CROSSED_S)
-        hi = bisect.bisect_right(times, t + _CROSSED_S)
-        tip = _tip(row)
-        for k in range(lo, hi):
-            pose = self._strokes[other][k][1]
-            tip_o = _tip(np.concatenate([pose.grip, pose.rot]))
-            if float((tip_o - tip) @ side) > 0.0 or np.linalg.norm(tip_o - tip) < 0.25:
-                return True  # crossed, or both on one piece
-        return False
 
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
@@ -699,7 +706,7 @@ class DrummerHands:
             room = t - cut
             # a far move with little time: the stick takes part of it (_reached); at this
             # impact the wrist still sits toward where it comes from ...
-            target = self._reached(hand, target, here, room, 1.0, t)
+            target = self._reached(hand, target, here, room, 1.0)
             # ... and already toward the next piece, when that stroke is known in time
             # and its move will be short of time too: from the start when it is known
             # before this move begins, else re-aimed from when it is known
@@ -708,7 +715,7 @@ class DrummerHands:
             if j is not None and strokes[j][0] < t - _REACH_MIN_S:
                 nxt_pose = strokes[j][1]
                 nxt_row = np.concatenate([nxt_pose.grip, nxt_pose.rot, nxt_pose.elbow])
-                reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5, t)
+                reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5)
             down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
             down = min(down, 0.5 * room) if room > 0 else 0.0
             rise = min(2 * down + 0.05, 0.5 * gap)
@@ -718,7 +725,7 @@ class DrummerHands:
                 travel = max(travel, s.rest_move_s)
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:  # ... or a little before: a slower move, when there is time
-                leave = max(t - _EARLY * travel, cut + 1e-4)
+                leave = max(t - s.move_early * travel, cut + 1e-4)
             if j is not None and strokes[j][0] <= max(leave, cut):
                 target = reached  # known before the hand leaves: the whole way to it
             if leave > cut + 1e-4:
@@ -826,10 +833,60 @@ class DrummerHands:
     # ------------------------------------------------------------------ output
 
     def targets(self, hand: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Wrist position (m, 3), hand world rotation (m, 4) and elbow hint (m, 3) at ``times``."""
+        """Wrist position (m, 3), hand world rotation (m, 4) and elbow hint (m, 3) at ``times``:
+        the hand's own track, bent around the other stick and the kit (:meth:`_clear`)."""
+        self._clear()
+        t = np.asarray(times, dtype=np.float64)
+        wrist, rot, elbow = self._track(hand, t)
+        return wrist + drummer_clear.offsets(self._detours[hand], t), rot, elbow
+
+    def _stick(self, hand: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The wrist and the stick's butt and tip, each (m, 3), on the hand's track with
+        its detours."""
+        wrist, rot, _elbow = self._track(hand, times)
+        wrist = wrist + drummer_clear.offsets(self._detours[hand], times)
+        grip = wrist + quat.rotate(rot, self._grip_off[hand])
+        axis = quat.rotate(rot, STICK_AXIS_LOCAL)
+        return wrist, grip - STICK_BUTT_M * axis, grip + STICK_TIP_M * axis
+
+    def _clear(self) -> None:
+        """Find the detours that keep the two sticks apart and off the kit, once per
+        change of either track: those begun by the last frame drawn stay (cut short
+        before an impact of their hand now after it), later ones are found anew."""
+        src = tuple(self.keys(h) if self.has_strokes(h) else None for h in HANDS)
+        old = self._detour_src
+        if old is not None and all(a is b for a, b in zip(src, old, strict=True)):
+            return
+        self._detour_src = src
+        floor = self._drawn
+        for h in HANDS:
+            for kept in (self._detours, self._lifts):
+                kept[h] = [_cut_detour(d, self._times[h], floor) for d in kept[h] if d.t0 <= floor]
+        known = [k for k in src if k is not None]
+        if not known:
+            return
+        impacts = [list(self._times[h]) for h in HANDS]
+        last = max((ts[-1] for ts in impacts if ts), default=-math.inf)
+        first = min(float(k.t[0]) for k in known)
+        span = (max(first, floor), last + 0.5)
+        if not all(math.isfinite(x) for x in span) or span[1] <= span[0]:
+            return
+        for _ in range(3):  # a detour may bring a stick near something else: again
+            fns = [
+                (lambda ts, h=h: self._stick(h, ts)) if k is not None else None
+                for h, k in zip(HANDS, src, strict=True)
+            ]
+            moves, lifts = drummer_clear.detours(fns, impacts, self._kit, span, floor)
+            if not any(moves) and not any(lifts):
+                break
+            for h, found, up in zip(HANDS, moves, lifts, strict=True):
+                self._detours[h] = sorted(self._detours[h] + found, key=lambda d: d.t0)
+                self._lifts[h] = sorted(self._lifts[h] + up, key=lambda d: d.t0)
+
+    def _track(self, hand: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`targets` on the hand's own key track (no detours)."""
         k = self.keys(hand)
         assert k is not None
-        t = np.asarray(times, dtype=np.float64)
         i0, i1, u = _shaped(k.t, k.profile, t, k.end_t)
         end = k.end_rows[i1]
         grip = k.grip[i0] + u[:, None] * (end[:, :3] - k.grip[i0])
@@ -850,6 +907,8 @@ class DrummerHands:
         lever = STICK_TIP_M + float(np.linalg.norm(off))
         sin_a = -d[:, 1]  # the stick's slope below the horizontal
         rise = (1.0 - s.wrist_share) * lift
+        if self._lifts[hand]:  # the tip over a piece it would go through (_clear)
+            rise = rise + drummer_clear.offsets(self._lifts[hand], t)[:, 1]
         theta = np.arcsin(np.clip(rise / lever - sin_a, -1.0, math.sin(math.radians(60.0))))
         theta = theta + np.arcsin(np.clip(sin_a, -1.0, 1.0))
         rot = quat.multiply(quat.from_axis_angle(axis, theta), rot)
@@ -887,6 +946,20 @@ class DrummerHands:
 
     def joint_index(self, hand: str) -> np.ndarray:
         return self._joints[hand]
+
+
+def _cut_detour(
+    d: drummer_clear.Detour, impacts: list[float], drawn: float
+) -> drummer_clear.Detour:
+    """A detour begun by ``drawn``, back to zero before its hand's first impact after
+    ``drawn`` (a stroke added since): unchanged at and before ``drawn``."""
+    k = bisect.bisect_right(impacts, max(drawn, d.t0))
+    if k == len(impacts) or impacts[k] >= d.t3 + drummer_clear.BEFORE_IMPACT_S:
+        return d
+    imp = impacts[k]
+    t2 = max(drawn, d.t1, min(d.t2, imp - 2 * drummer_clear.BEFORE_IMPACT_S))
+    t3 = min(max(t2 + 1e-3, imp - drummer_clear.BEFORE_IMPACT_S), imp)
+    return drummer_clear.Detour(d.t0, d.t1, t2, max(t3, t2 + 1e-4), d.vec)
 
 
 def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:

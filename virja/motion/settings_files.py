@@ -210,6 +210,7 @@ class HandMoveTable(Schema):
     speed_m_s: float
     rest_after_s: float
     rest_move_s: float
+    early: float = 2.0
 
 
 class HandReachTable(Schema):
@@ -256,9 +257,12 @@ def hand_settings(path: Path) -> HandSettings:
         move_speed_m_s=f.move.speed_m_s,
         rest_after_s=f.move.rest_after_s,
         rest_move_s=f.move.rest_move_s,
+        move_early=f.move.early,
         reach_speed_m_s=f.reach.speed_m_s,
         reach_max_m=f.reach.max_m,
     )
+    if not settings.move_early >= 1:
+        raise ConfigError(f"{path}: move.early must be a number >= 1, got {settings.move_early}")
     positive = {
         "lift.per_s": settings.lift_per_s,
         "lift.curve": settings.lift_curve,

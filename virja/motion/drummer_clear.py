@@ -1,0 +1,386 @@
+"""The drummer's two sticks kept apart as paths, and off the kit between strokes (issue 15).
+
+:mod:`virja.motion.drummer_hands` builds each hand's track from its own strokes; two
+tracks built apart can pass through each other (a left hand leaving the snare as the
+right comes down past it, hands crossing over the hi-hat) and a stick on its way can
+dip through a cymbal or a head (a left hand off the hi-hat for the snare 85 ms later,
+MMA Swing1 at 240 bpm: 22 such runs in 12 s).  Here both tracks are sampled together
+and where a stick comes too near the other stick, or a tip goes under a piece's
+surface inside its rim, one hand's track is bent away by a *detour*: a smooth offset
+of the whole hand (wrist, grip and stick moved together) that is zero at every
+impact of that hand, ramps in and out with smoothstep and holds over the conflict.
+
+- **stick against stick**: where the sticks come within ``STICK_TRIGGER_M``, one
+  hand moves: across the sticks to ``STICK_CLEAR_M``, or up over the other stick,
+  or back along its own; the least offset that fits between that hand's impacts,
+  keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
+  into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
+- **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
+  wrist stays where it is) until the tip is ``SURFACE_CLEAR_M`` over the surface:
+  over the rim, not through the cymbal.  (Moving the whole hand up instead added up
+  to 2.4 cm to the 30 fps jumps of the fast hi-hat-to-snare moves it fixed.)
+
+A detour never starts before a frame already drawn (``floor``), so a change of plan
+never changes a frame shown; one that would have to ramp faster than ``RAMP_SPEED_M_S``
+(``LIFT_SPEED_M_S`` for a lift; peak, smoothstep: 1.5 x its amplitude over its ramp)
+is not made.
+
+Pure functions over arrays: (n,) times, (n, 3) metres; detours as :class:`Detour`.
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from virja.geometry import Cymbal, Drum, DrumKit
+
+# two sticks nearer than this (closest points of their axes; virja.motion.
+# drummer_report counts them touching under 14 mm, two stick radii) are moved apart
+STICK_TRIGGER_M = 0.022
+STICK_CLEAR_M = 0.035
+# ... and a detour is made only if it keeps them this far apart over its whole window;
+# if the least offset does not, one STICK_MORE_M larger is tried
+STICK_APART_M = 0.018
+STICK_MORE_M = 0.02
+# a hand lifted over the other stick, or pulled back along its own stick out of the
+# other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these;
+# its left hand down from the crash to the snare through the crossed right stick at
+# 6.74 s is not cleared by 14 cm either: it would have to go round the stick's end)
+UP_M = (0.04, 0.07, 0.1, 0.14)
+# a tip more than SURFACE_TRIGGER_M under a piece's top inside its rim (+ a margin) is
+# lifted (the stick turned up about the wrist) to SURFACE_CLEAR_M over it
+SURFACE_TRIGGER_M = 0.002
+SURFACE_CLEAR_M = 0.012
+RIM_MARGIN_M = 0.01
+# a detour is zero this long after an impact of its hand and this long before the next
+# (the downstroke lands exactly where it was planned)
+AFTER_IMPACT_S = 0.006
+BEFORE_IMPACT_S = 0.03
+RAMP_MAX_S = 0.08  # ramps no longer than this (a detour is local)
+# a move detour holds this much longer on either side of its conflict, where it fits
+# (the least that keeps the sticks apart over the whole window): the sticks move on,
+# and held over the conflict alone the crossing came back just after it (GMD hiphop
+# 110 at 6.75 s: a left hand sweeping past the right stick over the hi-hat)
+HOLD_PAD_S = (0.025, 0.06, 0.12)
+RAMP_SPEED_M_S = 3.0  # the peak speed a detour adds (1.5 amplitude / ramp)
+# ... a lift's at the tip: a stick flicks up off a cymbal faster than a hand moves (a
+# downstroke's tip comes in at 5-10 m/s); 6 and 8 m/s left 12 and 4 of the 22 hi-hat
+# runs of MMA Swing1 at 240 bpm unmade (the tip under the hi-hat 20 ms after its
+# impact, 85 ms before the snare), 10 none
+LIFT_SPEED_M_S = 10.0
+# a lift starts at its hand's impact (the rebound) and ends this long before the next
+# (the tip under the snare's head 25 ms before its own stroke on it, coming in low
+# from the hi-hat: GMD punk 140 at 2.12 s)
+LIFT_BEFORE_S = 0.008
+SAMPLE_S = 1.0 / 240.0
+# a detour is made only if the wrist then moves no more between two 30 fps frames than
+# it did, or at most JUMP_OK_M, and no faster than it did, or at most SPEED_OK_M_S (a
+# detour ramping out into a fast move added up to 2 cm to a 30 fps jump)
+FRAME_30_S = 1.0 / 30.0
+JUMP_OK_M = 0.135
+SPEED_OK_M_S = 7.0
+
+
+@dataclass(frozen=True)
+class Detour:
+    """An offset ``vec`` (3,) m of one hand: 0 at ``t0``, smoothstep to full at ``t1``,
+    held to ``t2``, smoothstep back to 0 at ``t3``."""
+
+    t0: float
+    t1: float
+    t2: float
+    t3: float
+    vec: np.ndarray
+
+
+Window = tuple[float, float, float, float]  # a detour's (t0, t1, t2, t3)
+Stick = tuple[np.ndarray, np.ndarray, np.ndarray]  # wrist, butt, tip: each (n, 3) m
+Sticks = Callable[[np.ndarray], Stick]
+
+
+def offsets(detours: Sequence[Detour], times: np.ndarray) -> np.ndarray:
+    """The sum of ``detours`` at ``times`` (n,): (n, 3) m."""
+    t = np.asarray(times, dtype=np.float64)
+    out = np.zeros(t.shape + (3,))
+    for d in detours:
+        if t.size and (d.t3 <= t.min() or d.t0 >= t.max()):
+            continue
+        up = np.clip((t - d.t0) / max(d.t1 - d.t0, 1e-9), 0.0, 1.0)
+        down = np.clip((d.t3 - t) / max(d.t3 - d.t2, 1e-9), 0.0, 1.0)
+        w = np.minimum(up * up * (3 - 2 * up), down * down * (3 - 2 * down))
+        out += w[:, None] * d.vec
+    return out
+
+
+def _segment_closest(
+    p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points (n, 3) on segments p0-p1 and q0-q1, vectorised over the first axis."""
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a = np.einsum("ij,ij->i", d1, d1)
+    e = np.einsum("ij,ij->i", d2, d2)
+    f = np.einsum("ij,ij->i", d2, r)
+    c = np.einsum("ij,ij->i", d1, r)
+    b = np.einsum("ij,ij->i", d1, d2)
+    denom = a * e - b * b
+    s = np.where(denom > 1e-12, np.clip((b * f - c * e) / np.maximum(denom, 1e-12), 0, 1), 0.0)
+    t = np.clip((b * s + f) / np.maximum(e, 1e-12), 0, 1)
+    s = np.clip((b * t - c) / np.maximum(a, 1e-12), 0, 1)
+    return p0 + d1 * s[:, None], q0 + d2 * t[:, None]
+
+
+def _apart(a: Stick, b: Stick, gap: np.ndarray, i: int, j: int) -> np.ndarray:
+    """The one direction (3,) to hold the left stick ``a`` from the right one ``b`` over
+    samples ``i..j``, pointing to the side the left stick comes from: across both
+    sticks (their common normal) where they pass through each other, else along the
+    closest points' line.  (The closest points' line flips as one stick passes
+    through the other: a detour along it at the nearest sample only moved the
+    crossing a few ms on.)"""
+    k = i + int(np.argmin(np.linalg.norm(gap[i : j + 1], axis=1)))
+    n = np.cross(a[2][k] - a[1][k], b[2][k] - b[1][k])
+    norm = float(np.linalg.norm(n))
+    g = gap[k] / max(float(np.linalg.norm(gap[k])), 1e-9)
+    if norm > 1e-9 and abs(float(g @ (n / norm))) > 0.5:
+        g = n / norm  # the closest points lie across both sticks: they cross
+    first = gap[max(i - 1, 0)]
+    return g if float(first @ g) >= 0.0 else -g
+
+
+def _apart_over(
+    t: np.ndarray,
+    a: Stick,
+    b: Stick,
+    h: int,
+    w: Window,
+    vec: np.ndarray,
+) -> bool:
+    """Whether hand ``h`` moved by a detour (window ``w``, offset ``vec``) keeps the two
+    sticks (``a`` left, ``b`` right, sampled at ``t``) at least STICK_APART_M apart over
+    the whole window (a detour found on the nearest sample alone could push the
+    crossing a few ms on, or push the stick through the other one)."""
+    i = int(np.searchsorted(t, w[0]))
+    j = int(np.searchsorted(t, w[3], side="right"))
+    if j <= i:
+        return True
+    off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
+    sa = [p[i:j] + (off if h == 0 else 0.0) for p in a[1:]]
+    sb = [p[i:j] + (off if h == 1 else 0.0) for p in b[1:]]
+    pa, pb = _segment_closest(sa[0], sa[1], sb[0], sb[1])
+    return bool(np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M)
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True."""
+    f = np.concatenate([[0], flags.astype(np.int8), [0]])
+    edges = np.flatnonzero(np.diff(f))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def _window(
+    impacts: Sequence[float],
+    t_in: float,
+    t_out: float,
+    floor: float,
+    amp: float,
+    speed: float = RAMP_SPEED_M_S,
+    pad: float = 0.0,
+    after: float = AFTER_IMPACT_S,
+    before: float = BEFORE_IMPACT_S,
+) -> Window | None:
+    """(t0, t1, t2, t3) of a detour of amplitude ``amp`` held over [t_in, t_out],
+    between the hand's impacts (``impacts`` sorted) and after ``floor``; None when no
+    impact-free span holds it or its ramps would be too fast."""
+    k = bisect.bisect_right(impacts, t_in)
+    lo = max((impacts[k - 1] + after) if k else -np.inf, floor)
+    hi = impacts[k] - before if k < len(impacts) else np.inf
+    if k < len(impacts) and impacts[k] <= t_out:
+        return None  # an impact inside the conflict: nothing to bend
+    need = 1.5 * amp / speed
+    t1, t2 = max(t_in - pad, lo + need), min(t_out + pad, hi - need)
+    if t1 > t2:  # a conflict too near an impact: hold what fits, centred
+        mid = 0.5 * (t_in + t_out)
+        t1 = t2 = min(max(mid, lo + need), hi - need)
+        if lo + need > hi - need:
+            return None
+    ramp_in = min(RAMP_MAX_S, t1 - lo)
+    ramp_out = min(RAMP_MAX_S, hi - t2)
+    if min(ramp_in, ramp_out) < need:
+        return None
+    return t1 - ramp_in, t1, t2, t2 + ramp_out
+
+
+def _free(impacts: Sequence[float], t_in: float, t_out: float) -> float:
+    """How much free time ``impacts`` leave around [t_in, t_out] (the shorter side)."""
+    k = bisect.bisect_right(impacts, t_in)
+    before = t_in - impacts[k - 1] if k else 1.0
+    after = impacts[k] - t_out if k < len(impacts) else 1.0
+    return min(before, after)
+
+
+def _height(piece: Drum | Cymbal, tip: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(height (n,) m of ``tip`` (n, 3) over ``piece``'s struck surface, whether it is
+    within the piece's rim (+ RIM_MARGIN_M) and not below its body), as
+    virja.motion.drummer_report counts a stick in a piece."""
+    if isinstance(piece, Cymbal):
+        top, depth = piece.centre + piece.thickness / 2 * piece.normal, piece.thickness
+    else:
+        top, depth = piece.centre, piece.depth
+    rel = tip - top
+    hgt = rel @ piece.normal
+    radial = np.linalg.norm(rel - hgt[:, None] * piece.normal, axis=1)
+    return hgt, (hgt > -depth - 0.05) & (radial < piece.radius + RIM_MARGIN_M)
+
+
+def _under(kit: DrumKit, tip: np.ndarray) -> np.ndarray:
+    """(n,) how far (m) ``tip`` (n, 3) is under the deepest piece it is inside the rim
+    of (>= 0; 0 where it is under none)."""
+    out = np.zeros(len(tip))
+    for piece in kit.pieces.values():
+        hgt, inside = _height(piece, tip)
+        out = np.maximum(out, np.where(inside, -hgt, 0.0))
+    return out
+
+
+def _harmless(
+    t: np.ndarray,
+    stick: Stick,
+    w: Window,
+    vec: np.ndarray,
+    kit: DrumKit,
+) -> bool:
+    """Whether a detour (window ``w``, offset ``vec``) of a hand (wrist, butt, tip
+    sampled at ``t`` every SAMPLE_S) keeps the wrist within its 30 fps jump and speed
+    (see JUMP_OK_M) and the tip out of the kit where it was out."""
+    lag = int(round(FRAME_30_S / SAMPLE_S))
+    i = max(int(np.searchsorted(t, w[0])) - lag, 0)
+    j = min(int(np.searchsorted(t, w[3])) + lag + 1, t.size)
+    if j - i <= lag:
+        return True
+    seg = t[i:j]
+    off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], seg)
+    was = _under(kit, stick[2][i:j])
+    now = _under(kit, stick[2][i:j] + off)
+    if np.any((now > SURFACE_TRIGGER_M) & (now > was + 1e-4)):
+        return False
+    old = stick[0][i:j]
+    new = old + off
+
+    def figures(p: np.ndarray) -> tuple[float, float]:
+        jump = float(np.linalg.norm(p[lag:] - p[:-lag], axis=1).max())
+        return jump, float(np.linalg.norm(np.diff(p, axis=0), axis=1).max()) / SAMPLE_S
+
+    jo, so = figures(old)
+    jn, sn = figures(new)
+    return jn <= max(jo, JUMP_OK_M) and sn <= max(so, SPEED_OK_M_S)
+
+
+def _apart_detour(
+    t: np.ndarray,
+    both: tuple[Stick, Stick],
+    gap: np.ndarray,
+    run: tuple[int, int],
+    impacts: Sequence[Sequence[float]],
+    kit: DrumKit,
+    floor: float,
+) -> tuple[int, Detour] | None:
+    """(hand, detour) keeping the two sticks apart over the samples ``run`` where they
+    come near (``gap``: left minus right closest points), or None.
+
+    Tried in order of the offset's size, the higher first, then the hand with more
+    free time: either hand to either side across the sticks (the left kept on the
+    side it comes from, or on the side it goes to), then one hand up, over the other
+    stick, or pulled back along its own stick; each held longer (HOLD_PAD_S) if it
+    must.  The first that fits between the hand's impacts, keeps the sticks apart over
+    its whole window and harms nothing (:func:`_harmless`) is made."""
+    a, b = both
+    i, j = run
+    n = _apart(a, b, gap, i, j)
+    sep = gap[i : j + 1] @ n  # signed, from the right stick to the left one
+    t_in, t_out = float(t[i]), float(t[j])
+    free = [-_free(impacts[h], t_in, t_out) for h in (0, 1)]
+    tries = []
+    for side in (1.0, -1.0):
+        least = STICK_CLEAR_M - float((side * sep).min())
+        for amp in (least, least + STICK_MORE_M):
+            for h in (0, 1):
+                vec = (amp if h == 0 else -amp) * side * n
+                tries.append((amp, -vec[1], free[h], h, vec))
+    k = i + int(np.argmin(np.linalg.norm(gap[i : j + 1], axis=1)))
+    for amp in UP_M:
+        for h, stick in enumerate(both):
+            tries.append((amp, -amp, free[h], h, np.array([0.0, amp, 0.0])))
+            back = stick[1][k] - stick[2][k]
+            back[1] = 0.0
+            back = back / max(float(np.linalg.norm(back)), 1e-9)
+            tries.append((amp, 0.0, free[h], h, amp * back))
+    tries.sort(key=lambda x: x[:3])
+    for pad in HOLD_PAD_S:
+        for amp, _up, _free_s, h, vec in tries:
+            w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
+            if (
+                w is not None
+                and _apart_over(t, a, b, h, w, vec)
+                and _harmless(t, both[h], w, vec, kit)
+            ):
+                return h, Detour(w[0], w[1], w[2], w[3], vec)
+    return None
+
+
+def detours(
+    sticks: Sequence[Sticks | None],
+    impacts: Sequence[Sequence[float]],
+    kit: DrumKit,
+    span: tuple[float, float],
+    floor: float,
+) -> tuple[list[list[Detour]], list[list[Detour]]]:
+    """New detours of both hands over ``span`` (s), each starting after ``floor``:
+    (moves, lifts), each a list per hand; a move's ``vec`` offsets the whole hand, a
+    lift's ``vec[1]`` raises the tip, the stick turned up about the wrist.
+
+    ``sticks[h](times)`` gives hand ``h``'s wrist and stick (wrist, butt, tip), each
+    (n, 3), with the detours it already has; ``impacts[h]`` its impact times, sorted."""
+    out: list[list[Detour]] = [[], []]
+    lifts: list[list[Detour]] = [[], []]
+    t = np.arange(span[0], span[1], SAMPLE_S)
+    if t.size < 2:
+        return out, lifts
+    got = [None if f is None else f(t) for f in sticks]
+    left, right = got
+    if left is not None and right is not None:
+        pa, pb = _segment_closest(left[1], left[2], right[1], right[2])
+        gap = pa - pb
+        d = np.linalg.norm(gap, axis=1)
+        for i, j in _runs(d < STICK_CLEAR_M):
+            if d[i : j + 1].min() < STICK_TRIGGER_M:
+                found = _apart_detour(t, (left, right), gap, (i, j), impacts, kit, floor)
+                if found is not None:
+                    out[found[0]].append(found[1])
+    for h, s in enumerate(got):
+        if s is None:
+            continue
+        tip = s[2]
+        for piece in kit.pieces.values():
+            hgt, inside = _height(piece, tip)
+            for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):
+                amp = SURFACE_CLEAR_M - float(hgt[i : j + 1].min())
+                w = _window(
+                    impacts[h],
+                    float(t[i]),
+                    float(t[j]),
+                    floor,
+                    amp,
+                    LIFT_SPEED_M_S,
+                    0.0,
+                    0.0,
+                    LIFT_BEFORE_S,
+                )
+                if w is not None:  # the wrist stays: no jump, no speed added
+                    lifts[h].append(Detour(w[0], w[1], w[2], w[3], np.array([0.0, amp, 0.0])))
+    return out, lifts
+
+
+__all__ = ["Detour", "detours", "offsets"]

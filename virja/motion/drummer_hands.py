@@ -704,8 +704,11 @@ class DrummerHands:
                 gap = math.inf if prev_t is None else t - prev_t
                 here = _cut(pt, pv, pp, cut, _pose_at)
                 lift_here = float(_cut(lt, lv, lp, cut, _lift_at))
-            lift = self._lift_for(vel, gap, art)
             room = t - cut
+            # the backswing fits the time the hand has: since its last stroke, or since
+            # it learnt of this one when that is later (a hand the plan gives a note at
+            # the motion's start, live, has the lead from where it is, not the gap)
+            lift = self._lift_for(vel, min(gap, room), art)
             # a far move with little time: the stick takes part of it (_reached); at this
             # impact the wrist still sits toward where it comes from ...
             target = self._reached(hand, target, here, room, 1.0, t)

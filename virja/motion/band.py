@@ -165,7 +165,9 @@ class BandAnimator:
         self._hihat_pressed_y = float(pedal.toe_point(True)[1])
         self._ltoe = _SK.index("LeftToe")
         self.body = DrummerBody(self._roots[0], geometry, body)
-        self.hands = DrummerHands(self._roots[0], self.idle["drums"].rotations[0], hands)
+        self.hands = DrummerHands(
+            self._roots[0], self.idle["drums"].rotations[0], hands, geometry.kit
+        )
         self.bass_strings: tuple[str, ...] = BASS_STRINGS
         self.bassist = Bassist(geometry, self.settings.bassist)
         # where the bassist's chest stands when he stands still (the bass leans from there)

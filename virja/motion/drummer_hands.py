@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from virja.geometry import GEOMETRY, Cymbal, DrumKit
 from virja.motion import quat
 from virja.motion.clip import Clip
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_TIP_M
@@ -86,11 +87,17 @@ _YIELD_SHARE = 0.6  # out of the way within this share of the time to the other'
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
 _SQUEEZED, _RAMP = 4, 0.2
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
-# ... and its drop lags a little (was _DROP_LAG's u^2 like a move given its full time:
-# on a squeezed drop that doubled the grip's vertical speed at the end, on top of the
-# downstroke: the left hand hi-hat -> snare, 23 cm down in 100 ms, peaked at 6 m/s and
-# made the top percentile of MMA jazzwaltz at 300 bpm, p99 5.32 m/s)
-_SQUEEZED_LAG = 1.1
+# ... and its drop lags as a move given its full time does (_DROP_LAG, u^2), unless the
+# tip keeps clear of every piece on the way with the drop lagging only a little
+# (_SQUEEZED_LAG, u^1.1; the profile _SQUEEZED_CLEAR, DrummerHands._squeezed): u^2 on
+# a squeezed drop doubles the grip's vertical speed at its end, on top of the
+# downstroke (the left hand hi-hat -> snare, 23 cm down in 100 ms, peaked at 6 m/s:
+# the top percentile of MMA jazzwaltz at 300 bpm, p99 5.32 m/s), but off an open
+# hi-hat into a side-stick (MMA Swing1 at 240 bpm) u^1.1 took the tip 40-46 mm under
+# the top cymbal, where u^2 keeps it within 5-12 mm
+_SQUEEZED_CLEAR, _SQUEEZED_LAG = 6, 1.1
+_CLEAR_M = 0.002  # the tip (without its lift) this far over a piece's top counts as clear
+_CLEAR_SAMPLES = 24
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
 _REACH_MIN_S = 0.04
@@ -239,7 +246,9 @@ def _shaped(
         np.where(
             prof == _DECEL,
             1.0 - (1.0 - u) ** 2,
-            np.where(prof == _SQUEEZED, _ramped(u), u * u * (3 - 2 * u)),
+            np.where(
+                (prof == _SQUEEZED) | (prof == _SQUEEZED_CLEAR), _ramped(u), u * u * (3 - 2 * u)
+            ),
         ),
     )
     return i0, i1, u
@@ -262,7 +271,7 @@ def _shape(u: float, profile: int) -> float:
         return u * u
     if profile == _DECEL:
         return 1.0 - (1.0 - u) ** 2
-    if profile == _SQUEEZED:
+    if profile in (_SQUEEZED, _SQUEEZED_CLEAR):
         return float(_ramped(np.asarray(u)))
     return u * u * (3 - 2 * u)
 
@@ -272,17 +281,22 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
     down stays up until late (off a cymbal over its edge, not under it); on a move
     given its full time (:data:`_MOVE`) a hand going up also rises first, on a
     squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first, and
-    going down a little late; all start and end at rest."""
+    one whose tip keeps clear anyway (:data:`_SQUEEZED_CLEAR`) goes down only a little
+    late; all start and end at rest."""
     moving = (profile == _MOVE) | (profile == _MOVE_OFF_HIHAT)
     lead = np.where(
         moving,
         1.0 - (1.0 - u) ** _RISE_LEAD,
-        np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        np.where(
+            (profile == _SQUEEZED) | (profile == _SQUEEZED_CLEAR),
+            1.0 - (1.0 - u) ** _SQUEEZED_LEAD,
+            u,
+        ),
     )
     lag = np.where(
         profile == _MOVE_OFF_HIHAT,
         u**_HIHAT_LAG,
-        np.where(profile == _SQUEEZED, u**_SQUEEZED_LAG, u**_DROP_LAG),
+        np.where(profile == _SQUEEZED_CLEAR, u**_SQUEEZED_LAG, u**_DROP_LAG),
     )
     return np.where(rise > 0, lead, lag)
 
@@ -314,6 +328,19 @@ def _segment(profile: Any, t: float, value: Any) -> tuple[int, float, Any]:
     return profile if isinstance(profile, tuple) else (profile, t, value)
 
 
+def _track_at(times: list[float], values: list[Any], profiles: list[Any], x: float, at: Any) -> Any:
+    """A key track's value at ``x`` (as :func:`_cut` finds it, changing nothing)."""
+    k = bisect.bisect_right(times, x)
+    if k == 0:
+        return values[0]
+    if k == len(times):
+        return values[-1]
+    shape, end_t, end_v = _segment(profiles[k], times[k], values[k])
+    span = end_t - times[k - 1]
+    u = 1.0 if span <= 1e-12 else _shape((x - times[k - 1]) / span, shape)
+    return at(values[k - 1], end_v, u, shape)
+
+
 def _cut(times: list[float], values: list[Any], profiles: list[Any], cut: float, at: Any) -> Any:
     """The track's value at ``cut``; keys after ``cut`` are dropped and, unless one lies
     exactly there, a key holding that value is put at ``cut`` that remembers the cut
@@ -340,9 +367,14 @@ class DrummerHands:
     """The strokes of the drummer's two hands and the arm poses made from them."""
 
     def __init__(
-        self, root: np.ndarray, idle_local: np.ndarray, settings: HandSettings | None = None
+        self,
+        root: np.ndarray,
+        idle_local: np.ndarray,
+        settings: HandSettings | None = None,
+        kit: DrumKit | None = None,
     ) -> None:
         self.settings = settings or HandSettings.load()
+        self._kit = GEOMETRY.kit if kit is None else kit  # what a squeezed drop must clear
         self._root = np.asarray(root, dtype=np.float64)
         self._idle = np.asarray(idle_local, dtype=np.float64)
         p, r = _SK.fk(self._idle, self._root)
@@ -627,6 +659,43 @@ class DrummerHands:
                 return True  # crossed, or both on one piece
         return False
 
+    def _squeezed(
+        self,
+        pt: list[float],
+        pv: list[np.ndarray],
+        k: int,
+        lift: tuple[list[float], list[float], list[Any]],
+    ) -> int:
+        """The profile of the squeezed move ending at pose key ``k``:
+        :data:`_SQUEEZED_CLEAR` when it goes down and, its drop lagging only a little, the
+        stick's tip stays over the top of every piece it passes over (by
+        :data:`_CLEAR_M`, at even steps; the tip raised by the lift track ``lift`` there,
+        the lift being the tip's height); else :data:`_SQUEEZED`, whose drop waits until
+        late."""
+        here, target = pv[k - 1], pv[k]
+        if target[1] >= here[1]:
+            return _SQUEEZED  # a rise: both lead alike
+        fracs = np.linspace(0.0, 1.0, _CLEAR_SAMPLES + 1)[1:-1]
+        times = pt[k - 1] + fracs * (pt[k] - pt[k - 1])
+        tips = np.array(
+            [
+                _tip(_pose_at(here, target, _shape(f, _SQUEEZED_CLEAR), _SQUEEZED_CLEAR))
+                + float(_track_at(lift[0], lift[1], lift[2], x, _lift_at)) * _UP
+                for f, x in zip(fracs, times, strict=True)
+            ]
+        )
+        for piece in self._kit.pieces.values():
+            top = piece.centre + (piece.thickness / 2 if isinstance(piece, Cymbal) else 0.0) * (
+                piece.normal
+            )
+            rel = tips - top
+            h = rel @ piece.normal
+            radial = np.linalg.norm(rel - h[:, None] * piece.normal, axis=1)
+            depth = piece.thickness if isinstance(piece, Cymbal) else piece.depth
+            if ((h < _CLEAR_M) & (h > -depth - 0.05) & (radial < piece.radius)).any():
+                return _SQUEEZED
+        return _SQUEEZED_CLEAR
+
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
         if nothing follows), cut where the next stroke becomes known (its start, never
@@ -728,6 +797,7 @@ class DrummerHands:
             travel = float(way) / s.move_speed_m_s
             if prev_t is None and base is None:
                 travel = max(travel, s.rest_move_s)
+            squeezed: int | None = None  # the key of a squeezed move to this stroke
             leave = t - travel  # hover where the hand is; leave only when the move must start
             if leave > cut + 1e-4:  # ... or a little before: a slower move, when there is time
                 leave = max(t - _EARLY * travel, cut + 1e-4)
@@ -739,9 +809,11 @@ class DrummerHands:
                 off_hihat = prev_piece == "hihat"
                 _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
-                _add(pt, pv, pp, t, target, _SQUEEZED)
+                _add(pt, pv, pp, t, target, _SQUEEZED)  # its drop: _squeezed, below
+                squeezed = len(pt) - 1
             if reached is not target:  # known on the way: re-aimed from then
                 assert j is not None
+                squeezed = None
                 _cut(pt, pv, pp, strokes[j][0], _pose_at)
                 _add(pt, pv, pp, t, reached, _SQUEEZED)
                 target = reached
@@ -761,6 +833,8 @@ class DrummerHands:
                     _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)
                 _add(lt, lv, lp, t - down, lift, _SMOOTH)
             _add(lt, lv, lp, t, 0.0, _ACCEL)
+            if squeezed is not None and squeezed > 0:
+                pp[squeezed] = self._squeezed(pt, pv, squeezed, (lt, lv, lp))
             # the tail, as if no stroke followed: rebound to a hover, rest after a while
             hover = min(s.hover_m, lift, prev_lift if prev_t is not None else lift)
             away = t + 0.5 * s.rest_after_s

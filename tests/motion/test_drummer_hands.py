@@ -10,6 +10,7 @@ import pytest
 
 from tests.motion.helpers import assert_same_frames, drum, pose_live
 from virja.errors import ConfigError
+from virja.events import NoteOn
 from virja.geometry import GEOMETRY
 from virja.motion.band import BandAnimator, sticks
 from virja.motion.clip import MotionLibrary
@@ -485,3 +486,45 @@ def test_a_hand_gets_out_of_the_way_low_and_sideways(library: MotionLibrary, liv
     assert np.linalg.norm(stk[at, 0, 1] - stk[at, 1, 1]) > 0.1
     for p in notes:
         assert contact_distance(a, p, p.impact)[0] < 1e-4, (p.motion, p.impact)
+
+
+def test_a_hand_out_of_the_way_steps_aside_once_when_its_track_is_rebuilt_live(
+    library: MotionLibrary,
+) -> None:
+    """MMA jazzcombo at 240 bpm as live, 2.7-3.3 s: the left hand gets out of the way
+    of the right's snare stroke (12 cm aside by 2.98 s); at the frame of 3.0 s its next
+    stroke is shown (note_provisional), its track is frozen there and built on from
+    there, and meeting the other's stroke again it stepped a second 12 cm aside in 5 ms
+    (14.4 m/s).  Now it stays aside: frames drawn unchanged, no step."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+
+    def note(motion: str, impact: float, number: int, lead: float) -> PlannedNote:
+        return replace(drum(motion, impact - lead, impact, velocity=70), note=number)
+
+    fixed = [
+        note("hihat_right_hand", 2.7474, 42, 0.075),
+        note("snare_left_hand", 2.9076, 38, 0.1),
+        note("snare_right_hand", 3.0078, 38, 0.1),
+        note("hihat_right_hand", 3.2396, 42, 0.075),
+    ]
+    late = note("snare_left_hand", 3.2591, 38, 0.1)
+    events = [(p.start, 0, p) for p in (*fixed, late)] + [(3.03, 1, late)]
+    events.sort(key=lambda e: (e[0], e[1]))
+    ts = np.arange(2.5, 3.6, 1 / 30)
+    drawn, k = [], 0
+    for t in ts:
+        while k < len(events) and events[k][0] <= t + 1e-9:
+            _at, kind, p = events[k]
+            if kind == 1:  # known just after the frame of 3.0 s, shown at the next
+                a.note_known("drums", NoteOn(p.time, p.channel, p.note, p.velocity), 3.0091)
+                a.note_provisional([p])
+            else:
+                a.add_planned(p, known_at=None if p is late else p.impact - 0.25)
+            k += 1
+        drawn.append(a.local_rotations(float(t)))
+        a.mark_drawn(float(t))
+    assert_same_frames(a, ts, np.array(drawn))
+    for p in (*fixed, late):
+        assert contact_distance(a, p, p.impact)[0] < 1e-4
+    w = _wrists(a, np.arange(2.9, 3.3, 1 / 120), "Left")
+    assert np.linalg.norm(np.diff(w, axis=0), axis=1).max() * 120 < 5.0

@@ -14,7 +14,9 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   time is short); after ``rest_after_s`` without a stroke it goes to the
   relaxed ready pose and comes back in time for the next.  A move the plan
   leaves less time than that goes at even speed between short ramps
-  (``_SQUEEZED``), and the stick takes part of it: at the impacts on either side
+  (``_SQUEEZED``; its drop lags only a little where the tip keeps clear of every
+  piece that way, :meth:`DrummerHands._squeezed`), and the stick takes part of
+  it: at the impacts on either side
   the hand and stick are turned about the tip so the wrist sits toward the other
   piece (``reach_*``, :meth:`DrummerHands._reached`; not where the hands cross);
   a hand over a cymbal (or on the spot of a drum) that the other hand strikes
@@ -23,7 +25,8 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   scale of joint rotations), ``lift_soft_m`` .. ``lift_loud_m`` by velocity
   (to the power ``lift_curve``; a side-stick at most ``side_stick_m``, a rim
   shot at least ``rim_min_m``) and
-  at most ``lift_per_s`` times the time since the previous stroke; the stick
+  at most ``lift_per_s`` times the time since the previous stroke (or since the
+  hand could start for it, when later: a hand given a note live); the stick
   turns up about the wrist (the wrist itself rises ``wrist_share`` of it), so a
   soft stroke is a low one and nothing dives under a head or a cymbal.
 - **profiles**: into an impact the stick accelerates (u^2), out of it it

@@ -10,7 +10,8 @@ import numpy as np
 
 from tests.motion.helpers import assert_same_frames, drum
 from virja.events import NoteOn
-from virja.motion.band import BandAnimator
+from virja.geometry import GEOMETRY
+from virja.motion.band import BandAnimator, sticks
 from virja.motion.clip import MotionLibrary
 from virja.motion.drummer_body import BodySettings
 from virja.motion.drummer_hands import HandSettings
@@ -131,6 +132,30 @@ def test_a_revised_hand_changes_no_frame_drawn_and_moves_on_from_where_it_is(
     # leaves from where it is, no step at the frame where its course changed
     at = int(round((fixed.start - 0.9) * 120))
     assert speed[at - 2 : at, 0].max() < 5.0  # the first step after it: a start from rest
+
+
+def test_a_hand_given_the_note_at_its_motions_start_lifts_only_as_its_time_allows(
+    library: MotionLibrary,
+) -> None:
+    """The crash shown to the right hand, fixed to the left at the motion's start: the
+    left has the 60-67 ms from where it is, not the second since its last stroke (none),
+    so its backswing is what that time allows (lift.per_s x the time) and its stick comes
+    down on the crash no faster than a full stroke given its full time does (30 cm in
+    90 ms, accelerating: 6.7 m/s).  It came down at 10.3 m/s from a 19 cm backswing
+    squeezed into 30 ms.  Frames drawn stay as drawn, the contact exact."""
+    shown = _note("crash_right_hand", 1.5, 49)
+    fixed = _note("crash_left_hand", 1.5, 49)
+    a, ts, drawn = _play(library, [fixed], [(1.0, [shown])])
+    assert_same_frames(a, ts, drawn)
+    assert a.provisional_counts["fixed_other"] == 1
+    assert contact_distance(a, fixed, fixed.impact)[0] < 1e-4
+    fine = np.arange(fixed.start - 0.04, fixed.impact + 1e-9, 1 / 600)
+    pos, rot = SKELETON.fk(a.local_rotations_many(fine), a._roots)
+    crash = GEOMETRY.kit.pieces["crash"]
+    h = (sticks(pos[:, 0], rot[:, 0])[:, 0, 1] - crash.centre) @ crash.normal
+    s = HandSettings()
+    full_stroke = 2 * s.lift_loud_m / s.down_max_s
+    assert -np.diff(h).min() * 600 <= full_stroke
 
 
 def test_a_provisional_hand_revised_before_its_plan_and_taken_back(

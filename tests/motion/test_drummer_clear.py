@@ -125,3 +125,27 @@ def test_real_drumming_meets_the_targets_between_strokes(name: str, live: bool) 
     assert fig["wrist_speed_max_m_s"] <= 8.0  # type: ignore[operator]
     assert fig["contact_max_mm"] < 10.0  # type: ignore[operator]
     assert fig["timing_max_ms"] <= 0.5  # type: ignore[operator]
+
+
+def _cut(d: Detour, impacts: list[float], drawn: float) -> Detour:
+    from virja.motion.drummer_hands import _cut_detour
+
+    return _cut_detour(d, impacts, drawn)
+
+
+def test_a_detour_over_before_the_frame_drawn_is_not_held_again() -> None:
+    """As live on MMA JazzWaltz at 240 bpm: a detour cut short at one change (over by
+    0.344 s) was cut again at the frame of 0.367 s and held up to it, then dropped in a
+    millisecond (7 cm, 9.7 m/s)."""
+    d = Detour(0.233, 0.304, 0.3137, 0.3437, np.array([0.0, 0.07, 0.0]))
+    assert _cut(d, [0.0, 0.112, 0.3736, 0.629], 0.3667) is d
+
+
+def test_a_detour_on_its_way_back_ends_sooner_and_is_never_held_longer() -> None:
+    d = Detour(0.0, 0.1, 0.2, 0.5, np.array([0.0, 0.1, 0.0]))
+    drawn, impact = 0.3, 0.45
+    cut = _cut(d, [impact], drawn)
+    before = np.linspace(0.0, drawn, 61)
+    assert np.all(offsets([cut], before)[:, 1] <= offsets([d], before)[:, 1] + 1e-12)
+    assert offsets([cut], np.array([impact - BEFORE_IMPACT_S]))[0, 1] == 0.0
+    assert cut.t2 == d.t2 and cut.t3 <= impact - BEFORE_IMPACT_S + 1e-9

@@ -47,10 +47,12 @@ STICK_CLEAR_M = 0.035
 STICK_APART_M = 0.018
 STICK_MORE_M = 0.02
 # a hand lifted over the other stick, or pulled back along its own stick out of the
-# other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these;
-# its left hand down from the crash to the snare through the crossed right stick at
-# 6.74 s is not cleared by 14 cm either: it would have to go round the stick's end)
-UP_M = (0.04, 0.07, 0.1, 0.14)
+# other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these);
+# the last is about the most a ramp allows (RAMP_SPEED_M_S x RAMP_MAX_S / 1.5 = 16 cm):
+# GMD hiphop 110 at 6.27 s, the left stick rising from the snare under the crossed
+# right one as it comes down on the hi-hat, the left's tip 14 cm past the right stick:
+# pulled back 15.5 cm, its tip passes behind the right stick (14 cm: they still touch)
+UP_M = (0.04, 0.07, 0.1, 0.14, 0.155)
 # a tip more than SURFACE_TRIGGER_M under a piece's top inside its rim (+ a margin) is
 # lifted (the stick turned up about the wrist) to SURFACE_CLEAR_M over it
 SURFACE_TRIGGER_M = 0.002
@@ -157,13 +159,17 @@ def _apart_over(
     h: int,
     w: Window,
     vec: np.ndarray,
+    run: tuple[int, int],
 ) -> bool:
     """Whether hand ``h`` moved by a detour (window ``w``, offset ``vec``) keeps the two
     sticks (``a`` left, ``b`` right, sampled at ``t``) at least STICK_APART_M apart over
-    the whole window (a detour found on the nearest sample alone could push the
-    crossing a few ms on, or push the stick through the other one)."""
-    i = int(np.searchsorted(t, w[0]))
-    j = int(np.searchsorted(t, w[3], side="right"))
+    the whole window and the conflict's samples ``run`` (a detour found on the nearest
+    sample alone could push the crossing a few ms on, or push the stick through the
+    other one; one squeezed before its hand's impact could end before the conflict
+    begins and leave it as it was: GMD hiphop 110 at 6.27 s, a right-hand detour over
+    6.14-6.25 s for sticks crossing at 6.26-6.27 s, 10 ms before its hi-hat stroke)."""
+    i = min(int(np.searchsorted(t, w[0])), run[0])
+    j = max(int(np.searchsorted(t, w[3], side="right")), run[1] + 1)
     if j <= i:
         return True
     off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
@@ -323,7 +329,7 @@ def _apart_detour(
             w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
             if (
                 w is not None
-                and _apart_over(t, a, b, h, w, vec)
+                and _apart_over(t, a, b, h, w, vec, run)
                 and _harmless(t, both[h], w, vec, kit)
             ):
                 return h, Detour(w[0], w[1], w[2], w[3], vec)

@@ -3,8 +3,11 @@ pixels read from the X screen (not from any GL buffer), keys and mouse through X
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -103,7 +106,15 @@ def _hog(seconds: float) -> subprocess.Popen[bytes]:
         f"if __name__ == '__main__':\n    ps = [mp.Process(target=spin, args=({seconds},)) "
         "for _ in range(2)]\n    [p.start() for p in ps]; [p.join() for p in ps]\n"
     )
-    return subprocess.Popen([sys.executable, "-c", code])
+    # its own process group, so that _stop_hog ends the spinning children too (killing
+    # the parent alone left them busy for up to a minute into the tests after this one)
+    return subprocess.Popen([sys.executable, "-c", code], start_new_session=True)
+
+
+def _stop_hog(hog: subprocess.Popen[bytes]) -> None:
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(hog.pid, signal.SIGKILL)
+    hog.wait(timeout=10)
 
 
 def test_windowed_serve_under_load_plans_every_note_of_the_demo(
@@ -137,7 +148,7 @@ def test_windowed_serve_under_load_plans_every_note_of_the_demo(
         proc.send_signal(2)
         out, err = proc.communicate(timeout=30)
     finally:
-        hog.kill()
+        _stop_hog(hog)
         hog.wait()
         x.close()
         if proc.poll() is None:

@@ -28,9 +28,8 @@ def test_arrival_is_now_less_the_age_of_the_stamp_and_bounded() -> None:
 
 @pytest.mark.skipif(sys.platform != "linux", reason="SO_TIMESTAMPNS is Linux's")
 def test_a_datagram_read_late_keeps_its_arrival_time() -> None:
-    got: list[tuple[list[Received], float]] = []
-
-    async def main() -> float:
+    async def attempt() -> tuple[float, float, int, list[tuple[list[Received], float]]]:
+        got: list[tuple[list[Received], float]] = []
         clock = SessionClock()
         receiver = Receiver(ReceiverConfig(lateness_s=0.06))
         protocol = RmcpProtocol(receiver, clock, lambda ev, now: got.append((ev, now)))
@@ -39,21 +38,28 @@ def test_a_datagram_read_late_keeps_its_arrival_time() -> None:
         port = listener.get_extra_info("sockname")[1]
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
             sent_s = clock.now_s()
-            # a note due 500 ms from now: in time when it arrives (room for a heavily
-            # loaded machine to pause this thread before the send; 200 ms once was
-            # not enough under load), 1 s late when it is read
+            # a note due 500 ms from now: in time when it arrives, 1 s late when read
             data = wire.midi(3, 1, clock.now_us() + 500_000, bytes([0x99, 38, 100]))
             tx.sendto(bytes(data), ("127.0.0.1", port))
+            after_send_s = clock.now_s()
             time.sleep(1.5)  # the loop is busy (a long plan, a starved process)
             for _ in range(50):
                 await asyncio.sleep(0.01)
                 if got:
                     break
         listener.close()
-        assert receiver.stats.dropped["too_late"] == 0
-        return sent_s
+        return sent_s, after_send_s, receiver.stats.dropped["too_late"], got
 
-    sent_s = asyncio.run(main())
+    for _ in range(3):
+        sent_s, after_send_s, too_late, got = asyncio.run(attempt())
+        # the premise: the note was sent well before it was due.  A machine busy enough
+        # to pause this thread between the due time and the send (it happened in CI,
+        # even with 500 ms of room) makes it late on arrival: try again (bounded)
+        if after_send_s - sent_s < 0.25:
+            break
+    else:
+        pytest.skip("this thread was paused over 250 ms before each send: too busy to test")
+    assert too_late == 0
     assert len(got) == 1
     events, now_s = got[0]
     assert len(events) == 1 and not events[0].late

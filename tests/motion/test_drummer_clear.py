@@ -18,10 +18,10 @@ from virja.motion.drummer_clear import (
     Detour,
     Stick,
     Sticks,
-    _segment_closest,
     _window,
     detours,
     offsets,
+    segment_closest,
 )
 
 GMD = Path(__file__).resolve().parent.parent / "data" / "gmd"
@@ -84,7 +84,7 @@ def test_two_sticks_crossing_are_kept_apart_by_one_hand() -> None:
     h, d = made[0]
     la = [c + (offsets([d], t) if h == 0 else 0.0) for c in left[1:]]
     ra = [c + (offsets([d], t) if h == 1 else 0.0) for c in right[1:]]
-    pa, pb = _segment_closest(la[0], la[1], ra[0], ra[1])
+    pa, pb = segment_closest(la[0], la[1], ra[0], ra[1])
     assert np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M - 1e-9
 
 

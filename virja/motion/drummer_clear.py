@@ -118,7 +118,7 @@ def offsets(detours: Sequence[Detour], times: np.ndarray) -> np.ndarray:
     return out
 
 
-def _segment_closest(
+def segment_closest(
     p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Closest points (n, 3) on segments p0-p1 and q0-q1, vectorised over the first axis."""
@@ -175,7 +175,7 @@ def _apart_over(
     off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
     sa = [p[i:j] + (off if h == 0 else 0.0) for p in a[1:]]
     sb = [p[i:j] + (off if h == 1 else 0.0) for p in b[1:]]
-    pa, pb = _segment_closest(sa[0], sa[1], sb[0], sb[1])
+    pa, pb = segment_closest(sa[0], sa[1], sb[0], sb[1])
     return bool(np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M)
 
 
@@ -357,7 +357,7 @@ def detours(
     got = [None if f is None else f(t) for f in sticks]
     left, right = got
     if left is not None and right is not None:
-        pa, pb = _segment_closest(left[1], left[2], right[1], right[2])
+        pa, pb = segment_closest(left[1], left[2], right[1], right[2])
         gap = pa - pb
         d = np.linalg.norm(gap, axis=1)
         for i, j in _runs(d < STICK_CLEAR_M):

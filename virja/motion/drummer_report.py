@@ -33,6 +33,7 @@ import numpy as np
 from virja import quat
 from virja.geometry import Cymbal
 from virja.motion.band import BandAnimator, PlannedNoteLike, sticks
+from virja.motion.drummer_clear import segment_closest
 from virja.motion.skeleton import SKELETON
 
 _SK = SKELETON
@@ -112,19 +113,8 @@ def _runs(flags: np.ndarray) -> int:
 
 def _segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
     """Closest distance between segments p0-p1 and q0-q1, vectorised over the first axis."""
-    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a = np.einsum("ij,ij->i", d1, d1)
-    e = np.einsum("ij,ij->i", d2, d2)
-    f = np.einsum("ij,ij->i", d2, r)
-    c = np.einsum("ij,ij->i", d1, r)
-    b = np.einsum("ij,ij->i", d1, d2)
-    denom = a * e - b * b
-    s = np.where(denom > 1e-12, np.clip((b * f - c * e) / np.maximum(denom, 1e-12), 0, 1), 0.0)
-    t = (b * s + f) / np.maximum(e, 1e-12)
-    t = np.clip(t, 0, 1)
-    s = np.clip((b * t - c) / np.maximum(a, 1e-12), 0, 1)
-    diff = (p0 + d1 * s[:, None]) - (q0 + d2 * t[:, None])
-    return np.asarray(np.linalg.norm(diff, axis=1))
+    pa, pb = segment_closest(p0, p1, q0, q1)
+    return np.asarray(np.linalg.norm(pa - pb, axis=1))
 
 
 def _collisions(animator: BandAnimator, pos: np.ndarray, stk: np.ndarray) -> dict[str, int]:

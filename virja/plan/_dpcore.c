@@ -50,6 +50,25 @@ static int as_double_list(PyObject *seq, Py_ssize_t n, double *out) {
 /* hand_layer(keys, accs, cur_rl, cur_lefts, row_costs, row_kept, right_kept, right_class,
  *            left_kept, left_class, steps, n_rl, n_lefts, n_next_rows, drop_k, drop_pen)
  * -> (keys, accs, codes) of the next layer in first-reached order, or None. */
+/* A next layer's merge (hand_layer and hand_window): the key's first arrival is
+ * numbered in order, a later one replaces it only when strictly cheaper (the Python
+ * loop's order and strict <). */
+static inline void layer_merge(int32_t *index, long long *out_keys, double *out_tot,
+                               long long *out_came, Py_ssize_t *n_out, long long nkey,
+                               double total, long long code) {
+    int32_t at = index[nkey];
+    if (at < 0) {
+        index[nkey] = (int32_t)*n_out;
+        out_keys[*n_out] = nkey;
+        out_tot[*n_out] = total;
+        out_came[*n_out] = total < INFINITY ? code : 0;
+        (*n_out)++;
+    } else if (total < out_tot[at]) {
+        out_tot[at] = total;
+        out_came[at] = code;
+    }
+}
+
 static PyObject *hand_layer(PyObject *self, PyObject *args) {
     PyObject *keys_o, *accs_o, *row_costs_o, *row_kept_o, *right_kept_o, *right_class_o;
     PyObject *left_kept_o, *left_class_o, *steps_o;
@@ -194,17 +213,7 @@ static PyObject *hand_layer(PyObject *self, PyObject *args) {
                 Py_INCREF(result);
                 goto done;
             }
-            int32_t at = index[nkey];
-            if (at < 0) {
-                index[nkey] = (int32_t)n_out;
-                out_keys[n_out] = nkey;
-                out_tot[n_out] = total;
-                out_came[n_out] = total < INFINITY ? code : 0;
-                n_out++;
-            } else if (total < out_tot[at]) {
-                out_tot[at] = total;
-                out_came[at] = code;
-            }
+            layer_merge(index, out_keys, out_tot, out_came, &n_out, nkey, total, code);
         }
     }
     PyObject *ok = PyList_New(n_out), *oa = PyList_New(n_out), *oc = PyList_New(n_out);
@@ -962,17 +971,7 @@ static PyObject *hand_window(PyObject *self, PyObject *args) {
                     total = acc + drop_pen;
                     code = here + drop_k;
                 }
-                int32_t at = index[nkey];
-                if (at < 0) {
-                    index[nkey] = (int32_t)n_out;
-                    out_keys[n_out] = nkey;
-                    out_tot[n_out] = total;
-                    out_came[n_out] = total < INFINITY ? code : 0;
-                    n_out++;
-                } else if (total < out_tot[at]) {
-                    out_tot[at] = total;
-                    out_came[at] = code;
-                }
+                layer_merge(index, out_keys, out_tot, out_came, &n_out, nkey, total, code);
             }
         }
         /* the beam: the least-cost states, in their order (bounds.keep_best) */

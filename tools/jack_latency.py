@@ -11,7 +11,11 @@ uses).
   ``--size`` each frame; a note's latency ends when the first frame whose time
   is at or after the note's impact has been drawn.
 
-Prints the median, 95th percentile and worst.
+Prints the median, 95th percentile and worst.  ``--stages`` (with ``--impact``) also
+prints where a key's time goes, stage by stage (:data:`STAGES`: JACK to the handler's
+stamp, the wait for the frame in progress, planning, committing, the wait for the frame
+that poses the impact, that frame's pose, scene and draw), and the frames' pose, scene
+and draw with and without a note fed in their loop turn.
 
 JACK MIDI moves once per period, so expect figures of the order of one to two
 periods (``--period`` frames at ``--rate`` Hz; 256 at 48 kHz is 5.3 ms).
@@ -20,11 +24,13 @@ By default it starts its own server with the dummy driver (no sound card
 needed) and stops it at the end; ``--server NAME`` uses a running one instead.
 
     .venv/bin/python tools/jack_latency.py --notes 500
+    .venv/bin/python tools/jack_latency.py --impact --notes 100 --gap-ms 120 --stages
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import shutil
 import statistics
@@ -32,10 +38,15 @@ import subprocess
 import sys
 import threading
 import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import rtmidi
 
 from virja.jam.ports import MidiInput, quiet_c_stderr
+
+if TYPE_CHECKING:
+    from virja.session import Performance
 
 
 def _start_jackd(name: str, rate: int, period: int) -> subprocess.Popen[bytes]:
@@ -87,12 +98,73 @@ def measure(notes: int, gap_s: float) -> list[float]:
     return [arrivals[i] - sent[i] for i in range(min(len(sent), len(arrivals)))]
 
 
-def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[float]:
-    """Key-to-impact-drawn latencies (s) through the jam path and the renderer."""
+# The stages of one key's way to the screen, in the order they happen (each ends at the
+# stamp named; the first starts at the key sent).  Their sum is the key's latency.
+STAGES: tuple[tuple[str, str], ...] = (
+    ("jack", "sent -> stamped by the input's handler"),
+    ("wait", "stamped -> drained (the frame in progress)"),
+    ("feed", "drained -> routed and planned (feed_routed)"),
+    ("advance", "-> committed to the animator (advance)"),
+    ("to_frame", "-> start of the first frame posing the impact"),
+    ("pose", "that frame's pose (perf.pose)"),
+    ("scene", "that frame's scene (band_scene)"),
+    ("draw", "that frame drawn until finished"),
+)
+
+
+@dataclass
+class NoteStamps:
+    """Clock stamps (s) of one key on its way to the screen."""
+
+    sent: float = math.nan
+    stamped: float = math.nan
+    drained: float = math.nan
+    fed: float = math.nan
+    committed: float = math.nan
+    impact: float = math.nan  # the planned impact (its time on the session clock)
+    frame: float = math.nan  # the first frame posing the impact: its start
+    posed: float = math.nan
+    built: float = math.nan
+    drawn: float = math.nan
+    lead: float = math.nan  # that frame's lead (shown = frame + lead)
+
+    def stages(self) -> dict[str, float]:
+        marks = (self.sent, self.stamped, self.drained, self.fed, self.committed)
+        marks += (self.frame, self.posed, self.built, self.drawn)
+        return {name: b - a for (name, _), a, b in zip(STAGES, marks[:-1], marks[1:], strict=True)}
+
+    @property
+    def latency(self) -> float:
+        return self.drawn - self.sent
+
+
+@dataclass
+class ImpactRun:
+    """What :func:`measure_impact` saw: one :class:`NoteStamps` a key whose impact was
+    drawn, and the frames' (pose, scene, draw) seconds, marked when a note was fed in the
+    frame's loop turn (its pose is the first to hold that note)."""
+
+    notes: list[NoteStamps]
+    frames: list[tuple[bool, float, float, float]] = field(default_factory=list)
+
+    @property
+    def latencies(self) -> list[float]:
+        return [n.latency for n in self.notes]
+
+
+def jam_performance() -> Performance:
+    """The performance ``virja jam`` builds in its default (immediate) mode."""
     from virja.cli.cmd_jam import jam_settings
+    from virja.pipeline import build_performance
+
+    return build_performance(jam_settings({}, delay_s=0.0), animate=True)
+
+
+def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun:
+    """Key-to-impact-drawn latencies (s) through the jam path and the renderer, with the
+    stamps of each stage (:data:`STAGES`)."""
     from virja.jam.keyboard import KeyboardLayout
     from virja.jam.live import KeyboardJam
-    from virja.pipeline import build_performance
     from virja.render.camera import PRESETS
     from virja.render.hosts import OffscreenTarget, create_headless_context
     from virja.render.renderer import Renderer
@@ -100,7 +172,7 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[floa
 
     clock = time.perf_counter
     jam = KeyboardJam(KeyboardLayout(), delay_s=0.0, thru=None, stream=None)
-    perf = build_performance(jam_settings({}, delay_s=0.0), animate=True)
+    perf = jam_performance()
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     target = OffscreenTarget(ctx, size, samples=1)
@@ -108,10 +180,12 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[floa
     port = MidiInput("jack", jam.handle, clock)
     with quiet_c_stderr():
         out = rtmidi.MidiOut(rtmidi.API_UNIX_JACK, "latency-sender")
-    sent: dict[float, float] = {}  # note time (arrival) -> send time, via the planned note's time
     send_times: list[float] = []
+    # a key's note time is its arrival stamp (no delay): it names the key from the
+    # handler to the planned note
+    stamps: dict[float, NoteStamps] = {}
     pending: list[tuple[float, float]] = []  # (impact, note time)
-    lat: list[float] = []
+    frames: list[tuple[bool, float, float, float]] = []
     stop = threading.Event()
     lead_s = 0.0  # as virja.render.live.LiveView: draw the pose of when the frame appears
 
@@ -133,22 +207,47 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[floa
         arrivals: list[float] = []
         while not stop.is_set():
             now = clock()
+            fed = False
             for arrival in jam.drain():
                 r = arrival.routed
                 if r.performer is not None:
+                    got = NoteStamps(stamped=arrival.arrival_s, drained=clock())
                     perf.feed_routed(r.performer, r.event, now_s=arrival.arrival_s)
+                    got.fed = clock()
+                    stamps[arrival.arrival_s] = got
                     arrivals.append(arrival.arrival_s)
-            for p in perf.advance(now):
+                    fed = True
+            committed = perf.advance(now)
+            done = clock()
+            for p in committed:
                 pending.append((p.impact, p.time))
-            shown = now + lead_s
-            renderer.draw([static, band_scene(perf.pose(shown))], PRESETS["front"], target.fbo)
+                if p.time in stamps:
+                    stamps[p.time].committed = done
+                    stamps[p.time].impact = p.impact
+            frame = clock()
+            shown = frame + lead_s
+            pose = perf.pose(shown)
+            posed = clock()
+            scene = band_scene(pose)
+            built = clock()
+            renderer.draw([static, scene], PRESETS["front"], target.fbo)
             target.finish()
             drawn = clock()
+            frames.append((fed, posed - frame, built - posed, drawn - built))
+            lead = lead_s
             lead_s = min(0.1, 0.8 * lead_s + 0.2 * (drawn - now))
             still = []
             for impact, note_time in pending:
                 if impact <= shown:
-                    sent[note_time] = drawn
+                    if note_time in stamps:
+                        s = stamps[note_time]
+                        s.frame, s.posed, s.built, s.drawn, s.lead = (
+                            frame,
+                            posed,
+                            built,
+                            drawn,
+                            lead,
+                        )
                 else:
                     still.append((impact, note_time))
             pending[:] = still
@@ -159,11 +258,39 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> list[floa
         target.release()
         renderer.release()
         ctx.release()
-    # pair each drawn impact with the key that made it: note time = its arrival stamp
+    # pair each key sent with its arrival, in order
+    drawn_notes = []
     for k, arrival_s in enumerate(arrivals):
-        if k < len(send_times) and arrival_s in sent:
-            lat.append(sent[arrival_s] - send_times[k])
-    return lat
+        s = stamps[arrival_s]
+        if k < len(send_times) and not math.isnan(s.drawn):
+            s.sent = send_times[k]
+            drawn_notes.append(s)
+    return ImpactRun(drawn_notes, frames)
+
+
+def _p95(xs: list[float]) -> float:
+    ys = sorted(xs)
+    return ys[min(len(ys) - 1, int(0.95 * len(ys)))]
+
+
+def print_stages(run: ImpactRun) -> None:
+    """Median and p95 per stage (ms), and the frames' costs with and without a note fed."""
+    print("  stages (ms; medians need not add up to the total's):    median     p95")
+    per = [n.stages() for n in run.notes]
+    for name, what in STAGES:
+        xs = [s[name] * 1000.0 for s in per]
+        print(f"    {name:<9} {what:<48} {statistics.median(xs):7.2f} {_p95(xs):7.2f}")
+    stroke = statistics.median(n.impact - n.stamped for n in run.notes) * 1000.0
+    lead = statistics.median(n.lead for n in run.notes) * 1000.0
+    print(f"    (stamped -> planned impact {stroke:.2f}; that frame's lead {lead:.2f})")
+    for fed, label in ((True, "a note fed"), (False, "no note fed")):
+        rows = [f[1:] for f in run.frames if f[0] is fed]
+        if rows:
+            pose, scene, draw = (statistics.median(c) * 1000.0 for c in zip(*rows, strict=True))
+            print(
+                f"  frames with {label} ({len(rows)}): pose {pose:.2f}  scene {scene:.2f}  "
+                f"draw {draw:.2f} ms (medians)"
+            )
 
 
 def main() -> int:
@@ -177,6 +304,7 @@ def main() -> int:
         "--impact", action="store_true", help="key-to-impact through the whole jam path"
     )
     ap.add_argument("--size", default="1280x720", help="frame size drawn with --impact")
+    ap.add_argument("--stages", action="store_true", help="with --impact: the median of each stage")
     args = ap.parse_args()
 
     proc = None
@@ -186,11 +314,13 @@ def main() -> int:
         os.environ["JACK_DEFAULT_SERVER"] = name
     else:
         os.environ["JACK_DEFAULT_SERVER"] = args.server
+    run = None
     try:
         _wait_for_server()
         if args.impact:
             w, h = (int(x) for x in args.size.split("x"))
-            lat = measure_impact(args.notes, args.gap_ms / 1000.0, (w, h))
+            run = measure_impact(args.notes, args.gap_ms / 1000.0, (w, h))
+            lat = run.latencies
         else:
             lat = measure(args.notes, args.gap_ms / 1000.0)
     finally:
@@ -209,6 +339,8 @@ def main() -> int:
         print(f"  server: dummy driver, {args.rate} Hz, period {args.period} ({period_ms:.2f} ms)")
     print(f"  median {statistics.median(ms):.2f} ms   p95 {p95:.2f} ms   worst {ms[-1]:.2f} ms")
     print(f"  median in periods: {statistics.median(ms) / period_ms:.2f}")
+    if args.stages and run is not None:
+        print_stages(run)
     return 0
 
 

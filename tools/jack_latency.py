@@ -15,7 +15,15 @@ Prints the median, 95th percentile and worst.  ``--stages`` (with ``--impact``) 
 prints where a key's time goes, stage by stage (:data:`STAGES`: JACK to the handler's
 stamp, the wait for the frame in progress, planning, committing, the wait for the frame
 that poses the impact, that frame's pose, scene and draw), and the frames' pose, scene
-and draw with and without a note fed in their loop turn.
+and draw with and without a note fed in their loop turn, and where in the loop's turn
+the keys were sent.
+
+The keys come from a process of their own, as a keyboard's would (``--sender process``).
+Until round 8 they came from a thread of the measured process (``--sender thread``):
+each send then waited for the frame loop to let go of the GIL, so most keys went out
+just after a turn began and waited for the whole turn, not half of it on average; the
+longer the frames, the more that overstated the latency (docs/performance.md, "Key to
+impact through JACK").
 
 JACK MIDI moves once per period, so expect figures of the order of one to two
 periods (``--period`` frames at ``--rate`` Hz; 256 at 48 kHz is 5.3 ms).
@@ -30,6 +38,8 @@ needed) and stops it at the end; ``--server NAME`` uses a running one instead.
 from __future__ import annotations
 
 import argparse
+import bisect
+import json
 import math
 import os
 import shutil
@@ -38,6 +48,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -146,6 +157,18 @@ class ImpactRun:
 
     notes: list[NoteStamps]
     frames: list[tuple[bool, float, float, float]] = field(default_factory=list)
+    turns: list[float] = field(default_factory=list)  # when each loop turn began
+
+    def send_phases(self) -> list[float]:
+        """Where in the loop turn then in progress each key was sent (0: as the turn
+        began, 1: as it ended).  A keyboard's keys fall anywhere (even); keys sent at
+        the loop's own pauses cluster."""
+        out = []
+        for n in self.notes:
+            k = bisect.bisect_right(self.turns, n.sent) - 1
+            if 0 <= k < len(self.turns) - 1:
+                out.append((n.sent - self.turns[k]) / (self.turns[k + 1] - self.turns[k]))
+        return out
 
     @property
     def latencies(self) -> list[float]:
@@ -160,9 +183,74 @@ def jam_performance() -> Performance:
     return build_performance(jam_settings({}, delay_s=0.0), animate=True)
 
 
-def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun:
+def play(port_name: str, notes: int, gap_s: float, clock: Callable[[], float]) -> list[float]:
+    """Send ``notes`` keys to ``port_name`` ``gap_s`` apart, alternately a drum pad
+    (channel 10) and a bass key; returns when each was sent (``clock``)."""
+    with quiet_c_stderr():
+        out = rtmidi.MidiOut(rtmidi.API_UNIX_JACK, "latency-sender")
+    sent: list[float] = []
+    try:
+        out.open_port(out.get_ports().index(port_name))
+        time.sleep(0.3)  # let the connection settle before the first note
+        for i in range(notes):
+            msg = [0x90, 36 + i % 12, 100] if i % 2 else [0x99, 38, 100]
+            sent.append(clock())
+            out.send_message(msg)
+            time.sleep(gap_s)
+    finally:
+        out.delete()
+    return sent
+
+
+class _Sender:
+    """Plays the keys (:func:`play`) while the frame loop runs; ``sending()`` until done,
+    then ``times`` holds when each key was sent.
+
+    ``process`` (the default): from a process of its own, as a keyboard plays.
+    ``thread``: from a thread of the measured process, as before round 8: each send
+    waits for the frame loop to let go of the GIL, so the keys go out at the loop's own
+    pauses, not at random moments of its frames (docs/performance.md).
+    """
+
+    def __init__(self, how: str, port_name: str, notes: int, gap_s: float) -> None:
+        self.times: list[float] = []
+        self._child: subprocess.Popen[str] | None = None
+        self._thread: threading.Thread | None = None
+        if how == "thread":
+            self._thread = threading.Thread(
+                target=lambda: self.times.extend(play(port_name, notes, gap_s, time.monotonic)),
+                daemon=True,
+            )
+            self._thread.start()
+            return
+        cmd = [sys.executable, os.path.abspath(__file__), "--play-to", port_name]
+        cmd += ["--notes", str(notes), "--gap-ms", repr(gap_s * 1000.0)]
+        self._child = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+
+    def sending(self) -> bool:
+        if self._thread is not None:
+            return self._thread.is_alive()
+        assert self._child is not None and self._child.stdout is not None
+        if self._child.poll() is None:
+            return True
+        out = self._child.stdout.read()
+        if self._child.returncode != 0 or not out.strip():
+            sys.exit(f"the sender process failed (exit {self._child.returncode})")
+        self.times = json.loads(out)
+        return False
+
+    def close(self) -> None:
+        if self._child is not None and self._child.poll() is None:
+            self._child.kill()
+            self._child.wait()
+
+
+def measure_impact(
+    notes: int, gap_s: float, size: tuple[int, int], sender: str = "process"
+) -> ImpactRun:
     """Key-to-impact-drawn latencies (s) through the jam path and the renderer, with the
-    stamps of each stage (:data:`STAGES`)."""
+    stamps of each stage (:data:`STAGES`); the keys played by ``sender``
+    (:class:`_Sender`)."""
     from virja.jam.keyboard import KeyboardLayout
     from virja.jam.live import KeyboardJam
     from virja.render.camera import PRESETS
@@ -170,7 +258,7 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun
     from virja.render.renderer import Renderer
     from virja.render.scene import band_scene, static_scene
 
-    clock = time.perf_counter
+    clock = time.monotonic  # system-wide: the sender process's stamps compare
     jam = KeyboardJam(KeyboardLayout(), delay_s=0.0, thru=None, stream=None)
     perf = jam_performance()
     ctx = create_headless_context()
@@ -178,35 +266,23 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun
     target = OffscreenTarget(ctx, size, samples=1)
     static = static_scene()
     port = MidiInput("jack", jam.handle, clock)
-    with quiet_c_stderr():
-        out = rtmidi.MidiOut(rtmidi.API_UNIX_JACK, "latency-sender")
-    send_times: list[float] = []
     # a key's note time is its arrival stamp (no delay): it names the key from the
     # handler to the planned note
     stamps: dict[float, NoteStamps] = {}
     pending: list[tuple[float, float]] = []  # (impact, note time)
     frames: list[tuple[bool, float, float, float]] = []
-    stop = threading.Event()
+    turns: list[float] = []
     lead_s = 0.0  # as virja.render.live.LiveView: draw the pose of when the frame appears
-
-    def player() -> None:
-        time.sleep(0.3)
-        for i in range(notes):
-            send_times.append(clock())
-            # alternate a bass key and a drum pad (channel 10)
-            msg = [0x90, 36 + i % 12, 100] if i % 2 else [0x99, 38, 100]
-            out.send_message(msg)
-            time.sleep(gap_s)
-        time.sleep(0.3)
-        stop.set()
+    keys = _Sender(sender, port.name, notes, gap_s)
 
     try:
-        out.open_port(out.get_ports().index(port.name))
-        thread = threading.Thread(target=player, daemon=True)
-        thread.start()
         arrivals: list[float] = []
-        while not stop.is_set():
+        stop_at = math.inf
+        while clock() < stop_at:
+            if stop_at == math.inf and not keys.sending():
+                stop_at = clock() + 0.3  # the last impact's frames
             now = clock()
+            turns.append(now)
             fed = False
             for arrival in jam.drain():
                 r = arrival.routed
@@ -251,9 +327,8 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun
                 else:
                     still.append((impact, note_time))
             pending[:] = still
-        thread.join()
     finally:
-        out.delete()
+        keys.close()
         port.close()
         target.release()
         renderer.release()
@@ -262,10 +337,10 @@ def measure_impact(notes: int, gap_s: float, size: tuple[int, int]) -> ImpactRun
     drawn_notes = []
     for k, arrival_s in enumerate(arrivals):
         s = stamps[arrival_s]
-        if k < len(send_times) and not math.isnan(s.drawn):
-            s.sent = send_times[k]
+        if k < len(keys.times) and not math.isnan(s.drawn):
+            s.sent = keys.times[k]
             drawn_notes.append(s)
-    return ImpactRun(drawn_notes, frames)
+    return ImpactRun(drawn_notes, frames, turns)
 
 
 def _p95(xs: list[float]) -> float:
@@ -283,6 +358,12 @@ def print_stages(run: ImpactRun) -> None:
     stroke = statistics.median(n.impact - n.stamped for n in run.notes) * 1000.0
     lead = statistics.median(n.lead for n in run.notes) * 1000.0
     print(f"    (stamped -> planned impact {stroke:.2f}; that frame's lead {lead:.2f})")
+    phases = run.send_phases()
+    if phases:
+        quarters = [0, 0, 0, 0]
+        for ph in phases:
+            quarters[min(3, int(ph * 4))] += 1
+        print(f"  keys sent in each quarter of the loop turn in progress: {quarters}")
     for fed, label in ((True, "a note fed"), (False, "no note fed")):
         rows = [f[1:] for f in run.frames if f[0] is fed]
         if rows:
@@ -305,7 +386,18 @@ def main() -> int:
     )
     ap.add_argument("--size", default="1280x720", help="frame size drawn with --impact")
     ap.add_argument("--stages", action="store_true", help="with --impact: the median of each stage")
+    ap.add_argument(
+        "--sender",
+        choices=("process", "thread"),
+        default="process",
+        help="with --impact: play the keys from a process of their own (as a keyboard), "
+        "or from a thread of the measured process (before round 8)",
+    )
+    ap.add_argument("--play-to", default=None, help=argparse.SUPPRESS)  # the sender process
     args = ap.parse_args()
+    if args.play_to is not None:
+        print(json.dumps(play(args.play_to, args.notes, args.gap_ms / 1000.0, time.monotonic)))
+        return 0
 
     proc = None
     if args.server is None:
@@ -319,7 +411,7 @@ def main() -> int:
         _wait_for_server()
         if args.impact:
             w, h = (int(x) for x in args.size.split("x"))
-            run = measure_impact(args.notes, args.gap_ms / 1000.0, (w, h))
+            run = measure_impact(args.notes, args.gap_ms / 1000.0, (w, h), args.sender)
             lat = run.latencies
         else:
             lat = measure(args.notes, args.gap_ms / 1000.0)

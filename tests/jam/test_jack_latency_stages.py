@@ -62,3 +62,13 @@ def test_print_stages_names_every_stage_with_its_median(
         assert f"{run.notes[0].stages()[name] * 1000.0:.2f}" in line
     assert "frames with a note fed (1): pose 7.00" in out
     assert "frames with no note fed (1): pose 5.00" in out
+
+
+def test_send_phases_say_where_in_the_loop_turn_each_key_was_sent(tool: ModuleType) -> None:
+    a, b = _stamps(tool, 10.0), _stamps(tool, 11.0)
+    b.sent = 11.0075  # three quarters into the turn from 11.0 to 11.01
+    run = tool.ImpactRun([a, b], [], [9.99, 10.0, 10.02, 11.0, 11.01])
+    assert run.send_phases() == pytest.approx([0.0, 0.75])
+    # a key sent before the first turn or in the last (unfinished) one has no phase
+    late = _stamps(tool, 12.0)
+    assert tool.ImpactRun([late], [], [9.0, 11.5]).send_phases() == []

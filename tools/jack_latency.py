@@ -170,6 +170,16 @@ class ImpactRun:
                 out.append((n.sent - self.turns[k]) / (self.turns[k + 1] - self.turns[k]))
         return out
 
+    def turns_to_drain(self) -> list[float]:
+        """Each key's wait from sent to drained, in lengths of the loop turn it was sent in
+        (about half a turn plus JACK's period for keys sent at random moments)."""
+        out = []
+        for n in self.notes:
+            k = bisect.bisect_right(self.turns, n.sent) - 1
+            if 0 <= k < len(self.turns) - 1:
+                out.append((n.drained - n.sent) / (self.turns[k + 1] - self.turns[k]))
+        return out
+
     @property
     def latencies(self) -> list[float]:
         return [n.latency for n in self.notes]
@@ -364,6 +374,8 @@ def print_stages(run: ImpactRun) -> None:
         for ph in phases:
             quarters[min(3, int(ph * 4))] += 1
         print(f"  keys sent in each quarter of the loop turn in progress: {quarters}")
+        turns = statistics.median(run.turns_to_drain())
+        print(f"  sent -> drained: median {turns:.2f} loop turns")
     for fed, label in ((True, "a note fed"), (False, "no note fed")):
         rows = [f[1:] for f in run.frames if f[0] is fed]
         if rows:

@@ -72,3 +72,9 @@ def test_send_phases_say_where_in_the_loop_turn_each_key_was_sent(tool: ModuleTy
     # a key sent before the first turn or in the last (unfinished) one has no phase
     late = _stamps(tool, 12.0)
     assert tool.ImpactRun([late], [], [9.0, 11.5]).send_phases() == []
+
+
+def test_turns_to_drain_measure_the_wait_in_lengths_of_the_turn(tool: ModuleType) -> None:
+    a = _stamps(tool, 10.0)  # sent 10.0, drained 10.013
+    run = tool.ImpactRun([a], [], [9.99, 10.0, 10.02])
+    assert run.turns_to_drain() == pytest.approx([0.65])

@@ -299,10 +299,10 @@ def _needs(timing: Timing, piece: _HandKey) -> tuple[_Steps, _Need]:
             if piece is not None and timing.cross_penalty and timing.cross_window_s > 0:
                 is_left, other = piece
                 until = timing.cross_window_s - TIME_EPS_S
-                for prev in HAND_PIECES:
-                    left, right = (prev, other) if is_left else (other, prev)
+                for last in HAND_PIECES:
+                    left, right = (last, other) if is_left else (other, last)
                     if timing.crossed(left, right):
-                        idle[prev] = (until, ((until, timing.cross_penalty),))
+                        idle[last] = (until, ((until, timing.cross_penalty),))
             found = (idle, dict.fromkeys(prevs, -math.inf))
         else:
             steps: _Steps = {}

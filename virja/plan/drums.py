@@ -16,9 +16,9 @@ it needs, by tiers (distance / time since the hand's last stroke, timing.toml
 ``[hand_speed]``, :func:`stroke_penalty`), so that the hand with time plays, and a stroke
 that leaves the arms crossed while the other hand struck a moment before pays for the
 crossing (timing.toml ``[hand_cross]``, :func:`cross_penalty`).  A stroke that no hand
-can make in time is dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
-when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
-keeps the time).
+can make in time is dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping
+happens only when nothing else is feasible.  Ties go to the right hand (the time-keeping
+hand keeps the time).
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """

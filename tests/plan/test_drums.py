@@ -9,7 +9,7 @@ import random
 import pytest
 
 from virja.plan import drums
-from virja.plan.config import PlanConfig
+from virja.plan.config import PlanConfig, Timing
 from virja.plan.drums import LEFT, RIGHT, HandGroup, Stroke
 from virja.vocab import HAND_PIECES
 
@@ -147,6 +147,7 @@ def _objective(config: PlanConfig, groups: list[HandGroup], assigns: list[tuple]
                 total += c.drop_penalty + 9 - s.priority
         for h, s in sorted(played, key=lambda p: p[0] != LEFT):
             seq.append((g.time, h, s.piece))
+        total += _crossing(timing, g.time, {h: s.piece for h, s in played}, seq)
     last: dict[str, tuple[float, str]] = {}
     for k, (t, h, piece) in enumerate(seq):
         if h in last and t - last[h][0] < timing.stretch_gap(last[h][1], piece) - 1e-9:
@@ -160,6 +161,29 @@ def _objective(config: PlanConfig, groups: list[HandGroup], assigns: list[tuple]
             row = c.index(seq[k - 1][2], seq[k - 1][1])
         total += c.table[row][c.index(piece, h)]
     return total
+
+
+def _crossing(timing: Timing, t: float, group: dict[str, str], seq: list) -> float:  # type: ignore[type-arg]
+    """Crossed arms at short times (timing.toml [hand_cross]): the left hand's piece
+    right of the right hand's after this group (``group``: hand -> piece, already in
+    ``seq``), the other hand's stroke in the group or less than the window before."""
+    if len(group) == 2:
+        left, right, since = group[LEFT], group[RIGHT], 0.0
+    elif len(group) == 1:
+        ((hand, piece),) = group.items()
+        other = RIGHT if hand == LEFT else LEFT
+        before = [(tt, pc) for tt, h, pc in seq[:-1] if h == other]
+        if not before:
+            return 0.0
+        since = t - before[-1][0]
+        left, right = (piece, before[-1][1]) if hand == LEFT else (before[-1][1], piece)
+    else:
+        return 0.0
+    pos = timing.cross_positions
+    home = (right, left) in timing.cross_home
+    if since < timing.cross_window_s - 1e-9 and not home and pos[left] > pos[right]:
+        return timing.cross_penalty
+    return 0.0
 
 
 PIECES = ["snare", "hihat", "tom_high", "tom_low", "tom_floor", "ride", "crash"]
@@ -248,9 +272,12 @@ def test_a_move_pays_for_the_speed_it_needs_by_tiers(config: PlanConfig) -> None
     gap = timing.gap("snare", "tom_high")
     assert drums.stroke_penalty(timing, "snare", "tom_high", gap - 0.002) >= 150.0
     # a hand's stroke is remembered as long as a tier can charge it: memory_s
-    assert timing.max_gap == timing.speed_memory_s == 0.25
-    assert drums.stroke_penalty(timing, "ride", "crash", 0.26) == 0.0  # 3.3 m/s, forgotten
-    assert drums.stroke_penalty(timing, "ride", "crash", 0.24) == 4.0  # 3.6 m/s
+    # (and the crossing window, round 8: both 0.3 s)
+    assert timing.max_gap == timing.speed_memory_s == timing.cross_window_s == 0.3
+    assert 0.93 < timing.distances[("ride", "hihat")] < 0.96
+    assert drums.stroke_penalty(timing, "ride", "hihat", 0.305) == 0.0  # 3.1 m/s, forgotten
+    assert drums.stroke_penalty(timing, "ride", "hihat", 0.29) == 4.0  # 3.2 m/s
+    assert drums.stroke_penalty(timing, "ride", "crash", 0.26) == 4.0  # 3.3 m/s
 
 
 def test_at_300_bpm_the_hand_with_time_takes_the_snare_not_the_crossing_one(

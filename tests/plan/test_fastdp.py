@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -163,3 +164,39 @@ def test_input_the_window_does_not_take_is_left_to_python(
     compiled = drums.solve(costs, timing, drums.START, groups)
     monkeypatch.setattr(fastdp, "core", None)
     assert compiled == drums.solve(costs, timing, drums.START, groups)
+
+
+@needs_core
+def test_crossed_arms_cost_the_same_in_c_and_in_python(config: PlanConfig) -> None:
+    """Crossings at short times (timing.toml [hand_cross]): ride, hi-hat, snare and toms
+    at 300 bpm with the hands crossing and uncrossing, from a state with the left hand
+    just on the ride; the whole-window call, the per-group steps and the Python loop give
+    the same solution, with and without a cutting beam, and it pays crossings."""
+    costs, timing = config.costs, config.timing
+    pieces = [
+        ("ride",), ("snare", "hihat"), ("ride",), ("tom_floor", "hihat"), ("ride",),
+        ("snare",), ("hihat", "ride"), ("tom_low",), ("crash2", "snare"), ("ride",),
+    ]  # fmt: skip
+    groups = [
+        drums.HandGroup(
+            0.1 + 0.066 * i,
+            tuple(drums.Stroke(p, 2 + j, 0.003 * j) for j, p in enumerate(ps)),
+        )
+        for i, ps in enumerate(pieces * 2)
+    ]
+    m = costs.index("ride", drums.LEFT)
+    state: drums.HandState = (m, 0.05, 0.02, 0.05, "hihat", "ride")
+    for beam in (None, 3):
+        whole = drums.solve(costs, timing, state, groups, beam=beam)
+        core = fastdp.core
+        try:
+            fastdp.core = _StepsOnly(core)
+            steps = drums.solve(costs, timing, state, groups, beam=beam)
+            fastdp.core = None
+            plain = drums.solve(costs, timing, state, groups, beam=beam)
+        finally:
+            fastdp.core = core
+        assert whole == steps == plain
+    # the crossing is in the totals: without it the same input costs less
+    free = dataclasses.replace(timing, cross_penalty=0.0)
+    assert drums.solve(costs, free, state, groups).total < whole.total

@@ -43,6 +43,19 @@ def loops(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> It
     yield request.param
 
 
+def _crossed(timing: Timing, left: str | None, right: str | None, since: float) -> float:
+    """What the arms crossed cost: the left hand's piece right of the right hand's (but
+    for the home posture) within the window; written apart from the solver's."""
+    if left is None or right is None or (right, left) in timing.cross_home:
+        return 0.0
+    pos = timing.cross_positions
+    if left not in pos or right not in pos:  # a timing without positions: no crossing
+        return 0.0
+    if since < timing.cross_window_s - drums.TIME_EPS_S and pos[left] > pos[right]:
+        return timing.cross_penalty
+    return 0.0
+
+
 def _reference_drums(
     costs: DrumCosts,
     timing: Timing,
@@ -76,8 +89,16 @@ def _reference_drums(
             prev, prev_t, t_right, t_left, p_right, p_left = st
             row0 = prev if prev is not None and prev_t is not None and t - prev_t < rest_s else None
             for k, (_assign, played, penalty) in enumerate(compiled):
-                # feasible at all (stretch_gap), and what each stroke pays for stretch and speed
+                # feasible at all (stretch_gap), and what each stroke pays for stretch and
+                # speed; crossed arms (timing.toml [hand_cross]): a pair's two pieces with
+                # the drops, one hand's piece against the other's last where the other
+                # hand's own penalty would be (left hand first)
                 ok, stretched = True, penalty
+                hands = {is_right: piece for is_right, _m, piece, _i in played}
+                if len(hands) == 2:
+                    stretched = stretched + _crossed(timing, hands[False], hands[True], 0.0)
+                if len(hands) == 1 and True in hands and t_left is not None:
+                    stretched = stretched + _crossed(timing, p_left, hands[True], t - t_left)
                 for is_right, _m, piece, i in played:
                     last, lp = (t_right, p_right) if is_right else (t_left, p_left)
                     ts = t + group.strokes[i].dt
@@ -86,6 +107,8 @@ def _reference_drums(
                         ok = False
                     elif last is not None:  # at a stretch, at speed
                         stretched = stretched + drums.stroke_penalty(timing, lp, piece, ts - last)
+                if len(hands) == 1 and False in hands and t_right is not None:
+                    stretched = stretched + _crossed(timing, hands[False], p_right, t - t_right)
                 row, tr, tl, total = row0, t_right, t_left, acc + stretched
                 pr, pl = p_right, p_left
                 for is_right, m, piece, i in played:
@@ -190,6 +213,14 @@ def _random_case(
             speed_tiers=tiers,
             distances=rng.choice([{}, config.timing.distances]),
             speed_memory_s=rng.choice([math.inf, 0.2, 0.05]),
+        )
+    if rng.random() < 0.5:  # crossed arms: none, the shipped rule, odd windows and prices
+        timing = dataclasses.replace(
+            timing,
+            cross_window_s=rng.choice([0.0, 0.05, 0.1, config.timing.cross_window_s]),
+            cross_penalty=rng.choice([0.0, 0.5, 2.5, config.timing.cross_penalty]),
+            cross_home=rng.choice([frozenset(), config.timing.cross_home]),
+            cross_positions=rng.choice([{}, config.timing.cross_positions]),
         )
     state = drums.START
     if rng.random() < 0.3:  # a fixed state left by an earlier plan

@@ -204,6 +204,24 @@ class Timing:
     speed_tiers: tuple[tuple[float, float], ...] = ()
     distances: dict[tuple[str, str], float] = field(default_factory=dict)
     speed_memory_s: float = math.inf  # a stroke older than this pays no speed tier
+    # crossed arms at short times (timing.toml [hand_cross]): a stroke that leaves the
+    # left hand's piece right of the right hand's (``cross_positions``, across the kit
+    # left to right), the other hand having struck less than ``cross_window_s`` before
+    # (or in the same group), costs ``cross_penalty``; ``cross_home`` lists the (right
+    # piece, left piece) pairs of the home posture, which are not a crossing
+    cross_window_s: float = 0.0
+    cross_penalty: float = 0.0
+    cross_positions: dict[str, float] = field(default_factory=dict)
+    cross_home: frozenset[tuple[str, str]] = frozenset()
+
+    def crossed(self, left: str, right: str) -> bool:
+        """Whether the left hand on ``left`` and the right hand on ``right`` cross the
+        arms: the left hand's piece right of the right hand's, but for the home posture.
+        False for a piece without a position."""
+        pos = self.cross_positions
+        if left not in pos or right not in pos or (right, left) in self.cross_home:
+            return False
+        return pos[left] > pos[right]
 
     def get(self, kind: str) -> MotionTiming:
         try:
@@ -248,13 +266,14 @@ class Timing:
 
     @property
     def max_gap(self) -> float:
-        """The longest :meth:`gap` or speed tier's time: a stroke older than this
-        constrains nothing and costs nothing."""
+        """The longest :meth:`gap`, speed tier's time or crossing window: a stroke older
+        than this constrains nothing and costs nothing."""
         slowest = min((speed for speed, _pen in self.speed_tiers), default=math.inf)
         return max(
             max((mt.min_interval_s for mt in self.kinds.values()), default=0.0),
             max(self.moves.values(), default=0.0),
             min(max(self.distances.values(), default=0.0) / slowest, self.speed_memory_s),
+            self.cross_window_s if self.cross_penalty else 0.0,
         )
 
 
@@ -338,6 +357,13 @@ class HandSpeedTable(Schema):
     memory_s: float = math.inf
 
 
+class HandCrossTable(Schema):
+    window_s: float
+    penalty: float
+    positions: dict[str, float]
+    home: dict[str, list[str]] = msgspec.field(default_factory=dict)
+
+
 MotionTimingTable = schema_of(MotionTiming)
 
 
@@ -350,6 +376,7 @@ class TimingFile(Schema):
     hand_move: HandMoveTable | None = None
     hand_stretch: HandStretchTable | None = None
     hand_speed: HandSpeedTable | None = None
+    hand_cross: HandCrossTable | None = None
 
 
 class PlanTable(Schema):
@@ -497,6 +524,26 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
             speed_tiers=tuple(zip(speeds, pens, strict=True)),
             distances=hand_distances(),
             speed_memory_s=sp.memory_s,
+        )
+    if (cr := f.hand_cross) is not None:
+        pieces = set(HAND_PIECES)
+        home = {(r, left) for r, lefts in cr.home.items() for left in lefts}
+        if (
+            not cr.window_s >= 0
+            or not cr.penalty >= 0
+            or set(cr.positions) != pieces
+            or not {p for pair in home for p in pair} <= pieces
+        ):
+            raise ConfigError(
+                f"{where}: hand_cross needs window_s >= 0, penalty >= 0, a position for "
+                f"every hand piece ({', '.join(HAND_PIECES)}) and home pairs of hand pieces"
+            )
+        timing = dataclasses.replace(
+            timing,
+            cross_window_s=cr.window_s,
+            cross_penalty=cr.penalty,
+            cross_positions=dict(cr.positions),
+            cross_home=frozenset(home),
         )
     return timing
 

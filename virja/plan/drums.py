@@ -13,10 +13,12 @@ taps, buzz), longer the farther it has to travel to another piece; at a stretch
 ``stretch_penalty`` a stroke, as is a flam by one hand or a hi-hat stroke left to
 the foot (:func:`unplayed_penalty`).  A move to another piece also pays for the speed
 it needs, by tiers (distance / time since the hand's last stroke, timing.toml
-``[hand_speed]``, :func:`stroke_penalty`), so that the hand with time plays.  A stroke that no hand can make in time is
-dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
-when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
-keeps the time).
+``[hand_speed]``, :func:`stroke_penalty`), so that the hand with time plays, and a stroke
+that leaves the arms crossed while the other hand struck a moment before pays for the
+crossing (timing.toml ``[hand_cross]``, :func:`cross_penalty`).  A stroke that no hand
+can make in time is dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping
+happens only when nothing else is feasible.  Ties go to the right hand (the time-keeping
+hand keeps the time).
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """
@@ -123,17 +125,41 @@ def stroke_penalty(timing: Timing, prev: str | None, piece: str, since: float) -
     return 0.0
 
 
+def cross_penalty(timing: Timing, left: str | None, right: str | None, since: float) -> float:
+    """What a stroke that leaves the left hand on ``left`` and the right hand on
+    ``right`` pays for crossed arms (:meth:`Timing.crossed`), the other hand having
+    struck ``since`` seconds before the stroke's group (0 when both strike in the group):
+    ``Timing.cross_penalty`` when that is sooner than ``cross_window_s`` (less
+    TIME_EPS_S), else 0 (either hand on no piece: 0)."""
+    if (
+        not timing.cross_penalty
+        or left is None
+        or right is None
+        or not since < timing.cross_window_s - TIME_EPS_S
+        or not timing.crossed(left, right)
+    ):
+        return 0.0
+    return timing.cross_penalty
+
+
 def transition(
     costs: DrumCosts, timing: Timing, state: HandState, group: HandGroup, assign: Assignment
 ) -> tuple[float, HandState, tuple[float, ...]] | None:
     """Objective increment, next state and per-stroke table cost; None if infeasible.
 
     Per-stroke cost is the table cost that stroke paid (0 for a dropped one);
-    the increment adds the drop penalties.
+    the increment adds the drop penalties.  Crossed arms (:func:`cross_penalty`): when
+    both hands strike, their two pieces; when one does, its piece against the other
+    hand's last (added where that hand's own penalty would be, left hand first).
     """
     prev, prev_t, t_right, t_left, p_right, p_left = state
     t = group.time
+    by_hand = {h: s.piece for s, h in zip(group.strokes, assign, strict=True) if h is not None}
     stretch = 0.0
+    if len(by_hand) == 2:
+        stretch += cross_penalty(timing, by_hand[LEFT], by_hand[RIGHT], 0.0)
+    elif len(by_hand) == 1 and LEFT not in by_hand and t_left is not None:
+        stretch += cross_penalty(timing, p_left, by_hand[RIGHT], t - t_left)
     for stroke, by in sorted(
         ((s, h) for s, h in zip(group.strokes, assign, strict=True) if h is not None),
         key=lambda sh: sh[1] != LEFT,
@@ -145,6 +171,8 @@ def transition(
         if since < timing.stretch_gap(lp, stroke.piece) - TIME_EPS_S:
             return None
         stretch += stroke_penalty(timing, lp, stroke.piece, since)
+    if len(by_hand) == 1 and RIGHT not in by_hand and t_right is not None:
+        stretch += cross_penalty(timing, by_hand[LEFT], p_right, t - t_right)
     row = prev if prev is not None and prev_t is not None and t - prev_t < timing.rest_s else None
     order = sorted(
         (i for i, h in enumerate(assign) if h is not None),
@@ -236,12 +264,29 @@ _Played = tuple[
 _Classed = dict[str | None, tuple[float, tuple[tuple[float, int], ...]]]
 
 
-def _needs(timing: Timing, piece: str | None) -> tuple[_Steps, _Need]:
+# What a hand does in a played option: strikes a piece, or strikes nothing while the
+# other hand strikes one: (this hand is the left, the other hand's piece); None: strikes
+# nothing in an option where neither hand's last stroke matters to the other.
+_HandKey = str | tuple[bool, str] | None
+
+
+def _hand_key(piece: str | None, is_left: bool, other: str | None) -> _HandKey:
+    """The :data:`_HandKey` of a hand striking ``piece`` (None: nothing) while the other
+    hand strikes ``other``."""
+    if piece is None and other is not None:
+        return (is_left, other)
+    return piece
+
+
+def _needs(timing: Timing, piece: _HandKey) -> tuple[_Steps, _Need]:
     """For every previous piece of a hand (none included): :func:`_steps` with the
     largest of their times, and ``Timing.stretch_gap(prev, piece) - TIME_EPS_S``: the
     same floats :func:`transition` compares with, looked up once (made once per timing
     and piece: shared, read only).  A hand that does not play (``piece`` None) has no
-    steps and needs -inf."""
+    steps and needs -inf; one that does not play while the other hand strikes a piece
+    (``(is_left, other)``) needs -inf and its steps are the crossing
+    (:func:`cross_penalty`): ``(cross_window_s - TIME_EPS_S, cross_penalty)`` for a last
+    piece that crosses the arms with the other hand's, none for any other."""
     global _needs_cache
     entry = _needs_cache
     if entry is None or entry[0] is not timing:
@@ -249,8 +294,16 @@ def _needs(timing: Timing, piece: str | None) -> tuple[_Steps, _Need]:
     found = entry[1].get(piece)
     if found is None:
         prevs: tuple[str | None, ...] = (None, *HAND_PIECES)
-        if piece is None:
-            found = (dict.fromkeys(prevs, (-math.inf, ())), dict.fromkeys(prevs, -math.inf))
+        if piece is None or isinstance(piece, tuple):
+            idle: _Steps = dict.fromkeys(prevs, (-math.inf, ()))
+            if piece is not None and timing.cross_penalty and timing.cross_window_s > 0:
+                is_left, other = piece
+                until = timing.cross_window_s - TIME_EPS_S
+                for last in HAND_PIECES:
+                    left, right = (last, other) if is_left else (other, last)
+                    if timing.crossed(left, right):
+                        idle[last] = (until, ((until, timing.cross_penalty),))
+            found = (idle, dict.fromkeys(prevs, -math.inf))
         else:
             steps: _Steps = {}
             for prev in prevs:
@@ -264,7 +317,7 @@ def _needs(timing: Timing, piece: str | None) -> tuple[_Steps, _Need]:
 
 # the needs of the last timing used (matched by identity, as _cache below): a piece's
 # needs do not depend on the stroke's offset or priority, which make most signatures
-_needs_cache: tuple[Timing, dict[str | None, tuple[_Steps, _Need]]] | None = None
+_needs_cache: tuple[Timing, dict[_HandKey, tuple[_Steps, _Need]]] | None = None
 
 
 def _classed(steps: _Steps, scale: int) -> tuple[_Classed, list[float]]:
@@ -283,7 +336,7 @@ def _classed(steps: _Steps, scale: int) -> tuple[_Classed, list[float]]:
     return out, levels
 
 
-def _classed_for(timing: Timing, piece: str | None, scale: int) -> tuple[_Classed, list[float]]:
+def _classed_for(timing: Timing, piece: _HandKey, scale: int) -> tuple[_Classed, list[float]]:
     """:func:`_classed` of the steps of a hand striking ``piece`` (:func:`_needs`), made
     once per timing, piece and scale (shared, read only: every signature with that hand's
     piece has them)."""
@@ -298,7 +351,7 @@ def _classed_for(timing: Timing, piece: str | None, scale: int) -> tuple[_Classe
     return found
 
 
-_classed_cache: tuple[Timing, dict[tuple[str | None, int], tuple[_Classed, list[float]]]] | None = (
+_classed_cache: tuple[Timing, dict[tuple[_HandKey, int], tuple[_Classed, list[float]]]] | None = (
     None
 )
 
@@ -348,8 +401,12 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
             hand_of = {is_right: (piece, dt) for is_right, _m, piece, dt, _i in played}
             r_piece, r_dt = hand_of.get(True, (None, 0.0))
             l_piece, l_dt = hand_of.get(False, (None, 0.0))
-            r_steps, r_reach = _needs(timing, r_piece)
-            l_steps, l_reach = _needs(timing, l_piece)
+            if r_piece is not None and l_piece is not None:  # both strike: crossed arms?
+                penalty = penalty + cross_penalty(timing, l_piece, r_piece, 0.0)
+            r_key = _hand_key(r_piece, False, l_piece)
+            l_key = _hand_key(l_piece, True, r_piece)
+            r_steps, r_reach = _needs(timing, r_key)
+            l_steps, l_reach = _needs(timing, l_key)
             first, last = played[0][1], played[-1][1]
             flat.append(
                 (
@@ -368,10 +425,10 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                     costs.table[first][last] if len(played) == 2 else 0.0,
                 )
             )
-            l_classed, l_levels = _classed_for(timing, l_piece, 1)
+            l_classed, l_levels = _classed_for(timing, l_key, 1)
             n_left = len(l_levels)
             scales.append(n_left)
-            r_classed, r_levels = _classed_for(timing, r_piece, n_left)
+            r_classed, r_levels = _classed_for(timing, r_key, n_left)
             right_plays.append((r_dt, r_reach, r_classed))
             left_plays.append((l_dt, l_reach, l_classed))
             by_class = []
@@ -417,14 +474,14 @@ def _native(
     motion, right piece (-1: it does not play), right dt, left piece, left dt, offset of
     its penalties by class, their number, offset of the right hand's block, of the left
     hand's, the right hand's class scale (the left hand's number of penalties)]``; then
-    the penalties; then a block per hand piece met (:func:`_block`).  None when a piece
+    the penalties; then a block per hand key met (:func:`_block`).  None when a piece
     is not one of :data:`_PIECES` (the Python loop then runs)."""
     n = len(flat)
     head = [float(n), float(drop_k), drop_pen, float(len(_PIECES))]
     recs: list[float] = []
     tail: list[float] = []
     base = len(head) + 13 * n
-    where: dict[str | None, int] = {}  # each hand piece's block, placed once
+    where: dict[_HandKey, int] = {}  # each hand key's block, placed once
     blocks: list[list[float]] = []
     for played, by_class, scale in zip(flat, pens, scales, strict=True):
         k, r_piece, r_dt, _rs, _rr, l_piece, l_dt, _ls, _lr, last, _pen, first, pair = played
@@ -437,11 +494,13 @@ def _native(
         recs += [-1.0 if l_piece is None else float(_PIECE_NUMBER[l_piece]), l_dt]
         recs += [float(base + len(tail)), float(len(by_class))]
         tail += by_class
-        for piece in (r_piece, l_piece):
-            if piece not in where:
-                where[piece] = len(blocks)
-                blocks.append(_block(timing, piece))
-        recs += [float(where[r_piece]), float(where[l_piece]), float(scale)]
+        r_key = _hand_key(r_piece, False, l_piece)
+        l_key = _hand_key(l_piece, True, r_piece)
+        for key in (r_key, l_key):
+            if key not in where:
+                where[key] = len(blocks)
+                blocks.append(_block(timing, key))
+        recs += [float(where[r_key]), float(where[l_key]), float(scale)]
     at = base + len(tail)
     starts = []
     for block in blocks:
@@ -457,9 +516,9 @@ def _native(
     return out
 
 
-def _block(timing: Timing, piece: str | None) -> list[float]:
-    """What a hand striking ``piece`` (None: not playing) needs, as ``hand_window`` reads
-    it: per previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of
+def _block(timing: Timing, piece: _HandKey) -> list[float]:
+    """What a hand striking ``piece`` (a :data:`_HandKey`: None or ``(is_left, other)``
+    when it does not play) needs, as ``hand_window`` reads it: per previous piece in :data:`_PIECES` order ``[reach, largest step time, offset of
     its steps from the block's start, their number]``, then the steps ``(time, penalty
     number)``, the penalties numbered as :func:`_classed` numbers them (0 for none, then
     as met).  The same for every group: made once per timing and piece."""
@@ -483,7 +542,7 @@ def _block(timing: Timing, piece: str | None) -> list[float]:
     return found
 
 
-_blocks_cache: tuple[Timing, dict[str | None, list[float]]] | None = None
+_blocks_cache: tuple[Timing, dict[_HandKey, list[float]]] | None = None
 
 
 def _table_native(costs: DrumCosts) -> array[float]:

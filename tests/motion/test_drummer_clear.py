@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from contextlib import redirect_stderr, redirect_stdout
 from io import StringIO
 from pathlib import Path
@@ -166,7 +167,7 @@ def test_a_detour_on_its_way_back_ends_sooner_and_is_never_held_longer() -> None
     assert cut.t2 == d.t2 and cut.t3 <= impact - BEFORE_IMPACT_S + 1e-9
 
 
-def _plain_redo(self: Sampled, h: int, stick: Sticks, changed: list[Detour]) -> None:
+def _plain_redo(self: Sampled, h: int, stick: Sticks, changed: Sequence[Detour]) -> None:
     """:meth:`Sampled.redo` as the passes were before it: hand ``h`` sampled afresh
     over the whole span."""
     if changed and self.sticks[h] is not None:

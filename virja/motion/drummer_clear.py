@@ -358,8 +358,8 @@ class Sampled:
             return
         for h, f in enumerate(sticks):
             if f is not None:
-                self.sticks[h] = f(self.t)
-                self.heights[h] = [_height(p, self.sticks[h][2]) for p in self.pieces]
+                got = self.sticks[h] = f(self.t)
+                self.heights[h] = [_height(p, got[2]) for p in self.pieces]
 
     def redo(self, h: int, stick: Sticks, changed: Sequence[Detour]) -> None:
         """Hand ``h`` sampled again (``stick``, with its detours now) wherever one of

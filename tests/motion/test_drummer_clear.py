@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from contextlib import redirect_stderr, redirect_stdout
 from io import StringIO
 from pathlib import Path
@@ -16,8 +17,10 @@ from virja.motion.drummer_clear import (
     BEFORE_IMPACT_S,
     STICK_APART_M,
     Detour,
+    Sampled,
     Stick,
     Sticks,
+    _height,
     _window,
     detours,
     offsets,
@@ -162,3 +165,58 @@ def test_a_detour_on_its_way_back_ends_sooner_and_is_never_held_longer() -> None
     assert np.all(offsets([cut], before)[:, 1] <= offsets([d], before)[:, 1] + 1e-12)
     assert offsets([cut], np.array([impact - BEFORE_IMPACT_S]))[0, 1] == 0.0
     assert cut.t2 == d.t2 and cut.t3 <= impact - BEFORE_IMPACT_S + 1e-9
+
+
+def _plain_redo(self: Sampled, h: int, stick: Sticks, changed: Sequence[Detour]) -> None:
+    """:meth:`Sampled.redo` as the passes were before it: hand ``h`` sampled afresh
+    over the whole span."""
+    if changed and self.sticks[h] is not None:
+        got = self.sticks[h] = stick(self.t)
+        self.heights[h] = [_height(p, got[2]) for p in self.pieces]
+
+
+def _hands_detours(path: Path, seconds: float, plain: bool) -> list[list[tuple[float, ...]]]:
+    """Every detour (moves, then lifts, of each hand) the drummer's hands find over the
+    first ``seconds`` of ``path``, every note known; ``plain``: with :func:`_plain_redo`."""
+    from virja.input import load_performance_input
+    from virja.motion.drummer_hands import HANDS
+    from virja.pipeline import PerformanceSettings, build_performance
+    from virja.session import RevealFeeder
+
+    settings = PerformanceSettings()
+    src = load_performance_input(path, settings.routing)
+    perf = build_performance(settings, src, animate=True)
+    RevealFeeder([r for r in src.schedule if r.event.time_s <= seconds]).finish(perf)
+    hands = perf.animator.hands  # type: ignore[union-attr]
+    real_redo = Sampled.redo
+    try:
+        if plain:
+            Sampled.redo = _plain_redo  # type: ignore[method-assign]
+        hands._clear()
+    finally:
+        Sampled.redo = real_redo  # type: ignore[method-assign]
+    return [
+        [(d.t0, d.t1, d.t2, d.t3, *d.vec.tolist()) for d in kept[h]]
+        for kept in (hands._detours, hands._lifts)
+        for h in HANDS
+    ]
+
+
+@pytest.mark.parametrize(
+    ("name", "seconds"),
+    [
+        ("drummer3_session2_40_hiphop_110_beat_4-4.mid", 12.0),  # 6 moves, 2 lifts
+        ("drummer5_session1_13_afrocuban-calypso_124_beat_4-4.mid", 12.0),  # 3, 4
+    ],
+)
+def test_sampling_again_only_where_new_detours_reach_finds_the_same_detours(
+    name: str, seconds: float
+) -> None:
+    """The passes after the first sample a hand again only inside its new detours'
+    windows (:meth:`Sampled.redo`): the detours found are those of sampling both hands
+    afresh each pass, to the bit (moves and lifts, both hands)."""
+    fast = _hands_detours(GMD / name, seconds, plain=False)
+    plain = _hands_detours(GMD / name, seconds, plain=True)
+    # premise: moves and lifts found (so hands sampled again, and passes after the first)
+    assert plain[0] + plain[1] and plain[2] + plain[3]
+    assert fast == plain

@@ -14,6 +14,7 @@ core to the woken receiver first.
 from __future__ import annotations
 
 import contextlib
+import gc
 import logging
 import multiprocessing as mp
 import os
@@ -222,6 +223,11 @@ def viewer_main(spec: ViewerSpec, inbox: Any, back: Any, parent_pid: int, anchor
         anchor_s=anchor,
         alive=lambda: os.getppid() == parent_pid,
     )
+    # Start-up is over here too (modules, the GL context, the motion library): those
+    # objects live as long as the window, so they leave the collector's generations, as
+    # in `virja serve` (cmd_serve); a full collection of them is a frame's pause
+    # (docs/performance.md, "Pose and scene, eighth round").
+    gc.freeze()
     try:
         while loop.step():
             if not pacer.vsync and pacer.shown == 30:

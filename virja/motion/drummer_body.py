@@ -162,7 +162,12 @@ class DrummerBody:
         ``smooth_s`` (the target is a step function, so the turn is piecewise linear)."""
         t = np.asarray(t, dtype=np.float64)
         half = self.settings.smooth_s / 2
-        steps = np.unique(np.concatenate([np.asarray(self._times[h]) for h in HANDS]))
+        # sorted, each once (np.unique's first call imports numpy.ma: 16 ms in a render's
+        # first chunk; docs/performance.md, "Pose and scene, eighth round")
+        steps = np.sort(
+            np.concatenate([np.asarray(self._times[h], dtype=np.float64) for h in HANDS])
+        )
+        steps = steps[np.concatenate([[True], steps[1:] != steps[:-1]])] if steps.size else steps
         if steps.size == 0 or t.size == 0:
             return np.asarray(self._target(t))
         lo = min(float(t.min()) - half, float(steps[0])) - 1.0

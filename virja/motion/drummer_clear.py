@@ -336,6 +336,51 @@ def _apart_detour(
     return None
 
 
+class Sampled:
+    """Both hands' wrists and sticks sampled every SAMPLE_S over a span, and each tip's
+    height over every piece (:func:`_height`): what :func:`detours_in` looks at.
+
+    ``sticks[h](times)`` gives hand ``h``'s wrist and stick (wrist, butt, tip), each
+    (n, 3), with the detours it has then.  After new detours of a hand,
+    :meth:`redo` samples that hand again only inside their windows: a detour is zero
+    outside (t0, t3), and a sample depends on its own time alone, so the samples kept
+    are those a fresh sampling gives, to the bit (tests/motion/test_drummer_clear.py).
+    The second and third passes of :meth:`virja.motion.drummer_hands.DrummerHands._clear`
+    cost a few ms less each (docs/performance.md, "Pose and scene, eighth round")."""
+
+    def __init__(self, sticks: Sequence[Sticks | None], kit: DrumKit, span: tuple[float, float]):
+        self.t = np.arange(span[0], span[1], SAMPLE_S)
+        self.pieces = list(kit.pieces.values())
+        self.kit = kit
+        self.sticks: list[Stick | None] = [None] * len(sticks)
+        self.heights: list[list[tuple[np.ndarray, np.ndarray]]] = [[] for _ in sticks]
+        if self.t.size < 2:
+            return
+        for h, f in enumerate(sticks):
+            if f is not None:
+                got = self.sticks[h] = f(self.t)
+                self.heights[h] = [_height(p, got[2]) for p in self.pieces]
+
+    def redo(self, h: int, stick: Sticks, changed: Sequence[Detour]) -> None:
+        """Hand ``h`` sampled again (``stick``, with its detours now) wherever one of
+        the detours ``changed`` is not zero."""
+        have = self.sticks[h]
+        if have is None or not changed or self.t.size < 2:
+            return
+        keep = np.zeros(self.t.size + 1, dtype=np.int32)
+        for d in changed:
+            keep[np.searchsorted(self.t, d.t0)] += 1
+            keep[np.searchsorted(self.t, d.t3, side="right")] -= 1
+        idx = np.flatnonzero(np.cumsum(keep[:-1]) > 0)
+        if idx.size == 0:
+            return
+        new = stick(self.t[idx])
+        for old, part in zip(have, new, strict=True):
+            old[idx] = part
+        for (hgt, inside), piece in zip(self.heights[h], self.pieces, strict=True):
+            hgt[idx], inside[idx] = _height(piece, new[2])
+
+
 def detours(
     sticks: Sequence[Sticks | None],
     impacts: Sequence[Sequence[float]],
@@ -349,28 +394,30 @@ def detours(
 
     ``sticks[h](times)`` gives hand ``h``'s wrist and stick (wrist, butt, tip), each
     (n, 3), with the detours it already has; ``impacts[h]`` its impact times, sorted."""
+    return detours_in(Sampled(sticks, kit, span), impacts, floor)
+
+
+def detours_in(
+    sampled: Sampled, impacts: Sequence[Sequence[float]], floor: float
+) -> tuple[list[list[Detour]], list[list[Detour]]]:
+    """:func:`detours` over sticks already sampled (:class:`Sampled`)."""
     out: list[list[Detour]] = [[], []]
     lifts: list[list[Detour]] = [[], []]
-    t = np.arange(span[0], span[1], SAMPLE_S)
+    t = sampled.t
     if t.size < 2:
         return out, lifts
-    got = [None if f is None else f(t) for f in sticks]
-    left, right = got
+    left, right = sampled.sticks
     if left is not None and right is not None:
         pa, pb = segment_closest(left[1], left[2], right[1], right[2])
         gap = pa - pb
         d = np.linalg.norm(gap, axis=1)
         for i, j in _runs(d < STICK_CLEAR_M):
             if d[i : j + 1].min() < STICK_TRIGGER_M:
-                found = _apart_detour(t, (left, right), gap, (i, j), impacts, kit, floor)
+                found = _apart_detour(t, (left, right), gap, (i, j), impacts, sampled.kit, floor)
                 if found is not None:
                     out[found[0]].append(found[1])
-    for h, s in enumerate(got):
-        if s is None:
-            continue
-        tip = s[2]
-        for piece in kit.pieces.values():
-            hgt, inside = _height(piece, tip)
+    for h, heights in enumerate(sampled.heights):
+        for hgt, inside in heights:
             for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):
                 amp = SURFACE_CLEAR_M - float(hgt[i : j + 1].min())
                 w = _window(
@@ -389,4 +436,4 @@ def detours(
     return out, lifts
 
 
-__all__ = ["Detour", "detours", "offsets"]
+__all__ = ["Detour", "Sampled", "detours", "detours_in", "offsets"]

@@ -878,17 +878,21 @@ class DrummerHands:
         span = (max(first, floor), last + 0.5)
         if not all(math.isfinite(x) for x in span) or span[1] <= span[0]:
             return
+        fns = [
+            (lambda ts, h=h: self._stick(h, ts)) if k is not None else None
+            for h, k in zip(HANDS, src, strict=True)
+        ]
+        sampled = drummer_clear.Sampled(fns, self._kit, span)
         for _ in range(3):  # a detour may bring a stick near something else: again
-            fns = [
-                (lambda ts, h=h: self._stick(h, ts)) if k is not None else None
-                for h, k in zip(HANDS, src, strict=True)
-            ]
-            moves, lifts = drummer_clear.detours(fns, impacts, self._kit, span, floor)
+            moves, lifts = drummer_clear.detours_in(sampled, impacts, floor)
             if not any(moves) and not any(lifts):
                 break
-            for h, found, up in zip(HANDS, moves, lifts, strict=True):
+            for i, (h, found, up) in enumerate(zip(HANDS, moves, lifts, strict=True)):
                 self._detours[h] = sorted(self._detours[h] + found, key=lambda d: d.t0)
                 self._lifts[h] = sorted(self._lifts[h] + up, key=lambda d: d.t0)
+                fn = fns[i]
+                if fn is not None:  # sampled again only where the new detours reach
+                    sampled.redo(i, fn, found + up)
 
     def _track(self, hand: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`targets` on the hand's own key track (no detours)."""

@@ -164,6 +164,7 @@ def pack_instances(models: F64, colors: ArrayLike) -> F32:
     """(n, 20) float32 rows: the column-major matrix then RGBA."""
     n = models.shape[0]
     out = np.empty((n, 20), dtype=np.float32)
-    out[:, :16] = np.transpose(models, (0, 2, 1)).reshape(n, 16)
+    # the transposed matrices cast straight into the rows (no float64 copy between)
+    out[:, :16].reshape(n, 4, 4)[...] = np.transpose(models, (0, 2, 1))
     out[:, 16:] = np.broadcast_to(colors, (n, 4))
     return out

@@ -125,12 +125,11 @@ def band_scenes(batch: BandPoses, geo: Geometry = GEOMETRY) -> list[DrawList]:
 
     seg, seg_color, seg_keep = segs.matrices(spheres=False)
     sph, sph_color, _ = sphs.matrices(spheres=True)
-    cyl = np.concatenate([kit_cyl, seg], axis=1)
-    cyl_color = np.concatenate([kit_color, seg_color], axis=1)
     cyl_keep = np.concatenate([np.ones(kit_cyl.shape[:2], dtype=bool), seg_keep], axis=1)
     per_kind: dict[str, list[tuple[F64, F64]]] = {
         "box": [(boards, np.broadcast_to(np.asarray(CHROME), boards.shape[:2] + (4,)))],
-        "cylinder": [(cyl, cyl_color)],
+        # the kit's and the segments' rows joined once, with the bass's, below
+        "cylinder": [(kit_cyl, kit_color), (seg, seg_color)],
         "sphere": [(sph, sph_color)],
     }
     lean = np.asarray(batch.bass_transform, dtype=np.float64)

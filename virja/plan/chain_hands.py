@@ -24,6 +24,7 @@ from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
 from virja.plan.types import PlannedNote
+from virja.vocab import Hand
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
 # double trigger): the later ones ride on the first stroke, each at its own time.
@@ -65,7 +66,10 @@ class HandGroupPlan:
 
 
 def hand_group(
-    group: list[DrumHeld], t0: float, chick: Callable[[float], bool] | None = None
+    group: list[DrumHeld],
+    t0: float,
+    chick: Callable[[float], bool] | None = None,
+    pinned: bool = False,
 ) -> HandGroupPlan:
     """The strokes of a group: notes of one piece within SAME_STROKE_S are one stroke.
 
@@ -76,6 +80,8 @@ def hand_group(
     third distinct piece within the window is more than two hands can strike.
     ``chick(t)``: whether the left foot can take a hi-hat stroke at ``t``
     (``Stroke.foot``: when both hands are busy, a closed hi-hat note is a chick).
+    ``pinned``: each stroke carries the hand drawn moving for it (``Stroke.pin``, live,
+    when the group is fixed).
     """
     if not group:
         return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
@@ -86,6 +92,7 @@ def hand_group(
             velocity_priority(r.drum.priority, r.note.velocity),
             r.note.time_s - t0,
             chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+            r.pin if pinned else None,
         )
         return HandGroupPlan(drums_mod.HandGroup(t0, (stroke,)), [[r]], [], [])
     if len(group) == 2 and group[0].drum.piece != group[1].drum.piece:
@@ -103,6 +110,7 @@ def hand_group(
                         rank[0],
                         r.note.time_s - t0,
                         chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+                        r.pin if pinned else None,
                     )
                     for rank, r in pair
                 ),
@@ -156,6 +164,7 @@ def hand_group(
             prio[c[0].seq],
             c[0].note.time_s - t0,
             chick is not None and c[0].drum.piece == "hihat" and chick(c[0].note.time_s),
+            next((r.pin for r in c if r.pin is not None), None) if pinned else None,
         )
         for c in kept
     )
@@ -171,15 +180,32 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
-        # the steps of the latest solves by group time, with the group and the state
-        # it was solved from: what :meth:`provisional` reuses rather than solving again
-        self._seen: dict[float, tuple[drums_mod.HandGroup, drums_mod.HandState, HandStep]] = {}
+        # the groups and state :meth:`provisional` last solved, and its steps
+        self._shown: (
+            tuple[tuple[tuple[drums_mod.HandGroup, ...], drums_mod.HandState], list[HandStep]]
+            | None
+        ) = None
 
     def kind(self, drum: DrumNote) -> str:
         return drum.piece
 
     def forget_plan(self) -> None:
         self.plan.forget()
+
+    def pin(self, pins: dict[tuple[int, int, float], Hand]) -> int:
+        """Live: the hand drawn moving for each pending note (by channel, note and time
+        rounded to 1e-9 s; plan.types.HandPin), the whole current set: a note not in it
+        has no pin.  A pin binds when its group is fixed, at its motion's start
+        (:meth:`fix_groups`): the other hand then costs ``shown_hand_penalty`` more
+        (drums.switch_penalty).  Returns how many pending notes have one."""
+        n = 0
+        for r in self.pending:
+            hand = (
+                pins.get((r.note.channel, r.note.note, round(r.note.time_s, 9))) if pins else None
+            )
+            r.pin = hand
+            n += hand is not None
+        return n
 
     def _rebounds(self, groups: list[list[DrumHeld]], decide: bool = True) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
@@ -280,12 +306,20 @@ class HandsChain(DrumChain):
         aside = rebounds | {r.seq for r in self.pending if r.to_foot}
 
         prepared: dict[int, HandGroupPlan] = {}  # by the group's first note, made once
+        # live: the groups fixed now carry the hands drawn moving for their notes (pin);
+        # the plan kept for them was made without, so it is solved again
+        fixing = {g[0].seq for g in groups[:n_groups]}
+        if any(r.pin is not None for g in groups[:n_groups] for r in g):
+            self.plan.forget()
 
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
             hp = prepared.get(g[0].seq)
             if hp is None:
                 hp = prepared[g[0].seq] = hand_group(
-                    [r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick
+                    [r for r in g if r.seq not in aside],
+                    g[0].note.time_s,
+                    self.foot.can_chick,
+                    g[0].seq in fixing,
                 )
             return hp
 
@@ -298,9 +332,7 @@ class HandsChain(DrumChain):
                 hgs,
                 beam=self.ctx.bounds.beam,
             )
-            steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-            self._remember(hgs, self.state, steps)
-            return steps
+            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
 
         for gi in range(n_groups):
             hp = prepare(groups[gi])
@@ -308,21 +340,11 @@ class HandsChain(DrumChain):
             self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
             self.state = state
 
-    def _remember(
-        self, groups: list[drums_mod.HandGroup], state: drums_mod.HandState, steps: list[HandStep]
-    ) -> None:
-        """Keep solved ``steps`` of ``groups`` (solved from ``state``) for :meth:`provisional`."""
-        if len(self._seen) > 8 * self.ctx.bounds.window_groups:
-            self._seen.clear()
-        for g, step in zip(groups, steps, strict=True):
-            self._seen[g.time] = (g, state, step)
-            state = step[2]
-
     def provisional(self) -> list[PlannedNote]:
         """The hand each pending note would get if nothing more arrived, as planned notes
         not yet fixed (``cost`` 0): the plan the chain holds for the pending groups
-        (what the next commit fixes), else the latest solve's plan of the groups it
-        saw, continued over the groups new notes made (:meth:`_continued`).  Changes nothing: no note's decision is taken,
+        (what the next commit fixes), else the least-cost plan of them, as the commit
+        solves it (:meth:`_solved`).  Changes nothing: no note's decision is taken,
         nothing is fixed or emitted.  Rebounds of earlier strokes and hi-hat notes
         for the left foot are left out (their limb is not the solver's choice)."""
         if not self.pending:
@@ -338,7 +360,7 @@ class HandsChain(DrumChain):
             hand_group([r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick)
             for g in groups[:n]
         ]
-        steps = held if held else self._continued([hp.group for hp in hps])
+        steps = held if held else self._solved([hp.group for hp in hps])
         out: list[PlannedNote] = []
         for hp, (assignment, _costs, _state) in zip(hps, steps, strict=False):
             if len(assignment) != len(hp.group.strokes):
@@ -361,32 +383,27 @@ class HandsChain(DrumChain):
                 out.extend(_unfixed(r, stroke.piece, hand, r) for r in rest)
         return out
 
-    def _continued(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
-        """Steps for ``groups`` (the pending ones, from the chain's state): those of the
-        latest solve while its groups and states are the same, then a solve of the
-        rest from there (usually the one group a new note made).  Cheap, and a plan
-        only to look at: the commit solves its window as always."""
-        self._seen = {t: v for t, v in self._seen.items() if t >= groups[0].time}
-        state = self.state
-        steps: list[HandStep] = []
-        for g in groups:
-            seen = self._seen.get(g.time)
-            if seen is None or seen[0] != g or seen[1] != state:
-                break
-            steps.append(seen[2])
-            state = seen[2][2]
-        rest = groups[len(steps) :]
-        if rest:
-            sol = drums_mod.solve(
-                self.ctx.config.costs,
-                self.ctx.config.timing,
-                state,
-                rest,
-                beam=self.ctx.bounds.beam,
-            )
-            more = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-            self._remember(rest, state, more)
-            steps += more
+    def _solved(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
+        """Steps for ``groups`` (the pending ones, at most a window, from the chain's
+        state): the least-cost plan of them all, as the commit solves it, the last one
+        kept while the groups and state are the same.  Before round 8 the latest solve's
+        steps were continued by a solve of the groups a new note made; that plan could
+        differ from the commit's (a ride shown to the left hand after a hi-hat stroke
+        shown right, where the commit gives the hi-hat to the foot and the ride to the
+        right), and live a hand shown moving now keeps its note (:meth:`pin`), so what is
+        shown is the commit's plan.  Changes nothing the commit uses."""
+        key = (tuple(groups), self.state)
+        if self._shown is not None and self._shown[0] == key:
+            return self._shown[1]
+        sol = drums_mod.solve(
+            self.ctx.config.costs,
+            self.ctx.config.timing,
+            self.state,
+            groups,
+            beam=self.ctx.bounds.beam,
+        )
+        steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+        self._shown = (key, steps)
         return steps
 
     def _fix_group(

@@ -16,7 +16,9 @@ it needs, by tiers (distance / time since the hand's last stroke, timing.toml
 ``[hand_speed]``, :func:`stroke_penalty`), so that the hand with time plays.  A stroke that no hand can make in time is
 dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
 when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
-keeps the time).
+keeps the time).  Live, a stroke whose provisional hand is already drawn moving for it
+(``Stroke.pin``) costs ``shown_hand_penalty`` more with the other hand
+(:func:`switch_penalty`): kept unless that would drop a note.
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """
@@ -46,6 +48,9 @@ class Stroke:
     priority: int
     dt: float = 0.0  # its note's time after the group's time (within the grouping window)
     foot: bool = False  # a hi-hat stroke the left foot can take (a chick on the pedal)
+    # live only: the hand drawn moving for it already (a pin, plan.types.HandPin); the
+    # other hand costs ``DrumCosts.shown_hand_penalty`` more (:func:`switch_penalty`)
+    pin: Hand | None = None
 
 
 @dataclass(frozen=True)
@@ -108,6 +113,15 @@ def unplayed_penalty(
     return drop_penalty(costs, strokes[i])
 
 
+def switch_penalty(costs: DrumCosts, stroke: Stroke, hand: Hand | None) -> float:
+    """What giving ``stroke`` to ``hand`` costs beyond the table because another hand
+    was drawn moving for it (``Stroke.pin``, live only): ``shown_hand_penalty`` for
+    the other hand, nothing for the pinned one or a drop (which pays its own)."""
+    if stroke.pin is None or hand is None or hand == stroke.pin:
+        return 0.0
+    return costs.shown_hand_penalty
+
+
 def _steps(timing: Timing, prev: str | None, piece: str) -> tuple[tuple[float, float], ...]:
     """:meth:`Timing.penalty_steps` with ``TIME_EPS_S`` taken off each time."""
     return tuple((time - TIME_EPS_S, pen) for time, pen in timing.penalty_steps(prev, piece))
@@ -167,6 +181,8 @@ def transition(
     for i, hand in enumerate(assign):
         if hand is None:
             total += unplayed_penalty(costs, timing, group.strokes, assign, i)
+        elif group.strokes[i].pin is not None:
+            total += switch_penalty(costs, group.strokes[i], hand)
     if order:
         prev, prev_t = row, t
     return total, (prev, prev_t, t_right, t_left, p_right, p_left), tuple(per)
@@ -197,7 +213,8 @@ class _Option:
     """One assignment of a group, precompiled: what :func:`transition` computes each time.
 
     ``played`` lists the played strokes left hand first as ``(is_right, motion, piece,
-    dt, stroke index)``; ``penalty`` is the sum of the drop penalties.
+    dt, stroke index)``; ``penalty`` is the sum of the drop penalties (and, live, of
+    the :func:`switch_penalty` of a stroke given the other hand than its pin).
     """
 
     assign: Assignment
@@ -339,6 +356,8 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
             if hand is None:
                 penalty += unplayed_penalty(costs, timing, strokes, assign, i)
             else:
+                if stroke.pin is not None:  # live: another hand drawn moving for it
+                    penalty += switch_penalty(costs, stroke, hand)
                 played.append(
                     (hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, stroke.dt, i)
                 )

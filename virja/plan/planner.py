@@ -17,7 +17,7 @@ What every chain shares is in :mod:`virja.plan.chain`.  See docs/scheduler.md.
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from virja.events import Beat, NoteOn
 from virja.plan.bounds import DEFAULT_BOUNDS, PlanBounds
@@ -34,7 +34,7 @@ from virja.plan.chain_hands import (
 )
 from virja.plan.chain_kit import HAND_WINDOW_S, REBOUND_VELOCITY
 from virja.plan.config import PlanConfig, default_config
-from virja.plan.types import PlannedNote, PlanReport
+from virja.plan.types import HandPin, PlannedNote, PlanReport
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, Tempo
 from virja.vocab import Performer
 
@@ -157,6 +157,17 @@ class OnlinePlanner:
             chain.take(chain.held(self._seq, note, now_s, dn))
         else:
             raise ValueError(f"unknown performer {performer!r}")
+
+    def pin_hands(self, pins: Iterable[HandPin]) -> int:
+        """Live: the drum notes whose provisional hand is drawn moving for them now (the
+        animator says which, ``BandAnimator.shown_moving``; the performance passes the
+        whole current set before each commit).  When such a note's group is fixed, at
+        its motion's start, the plan keeps that hand unless only the other plays it, or
+        another note, in time (``shown_hand_penalty``, below a drop: docs/motion.md,
+        round 8).  Before that the plan may still give it the other hand, which then
+        has more than the lead.  Returns how many pending notes have a pin.  Whole-input
+        planning (``run_schedule``) draws nothing and pins none: its plans are unchanged."""
+        return self._hands.pin({(p.channel, p.note, round(p.time_s, 9)): p.hand for p in pins})
 
     # -- outputs --------------------------------------------------------------
 

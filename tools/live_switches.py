@@ -64,14 +64,17 @@ def measure(path: Path, max_seconds: float, pins: bool) -> dict[str, Any]:
     a = perf.animator
     assert isinstance(a, BandAnimator)
     counts = a.provisional_counts
-    moving = [s for s in a.hand_switches if s.moving_since is not None]
+    # every note taken from a hand drawn moving, and every note fixed to another limb
+    moving = [s for s in a.hand_switches if s.moving_since is not None or s.kind == "fixed"]
     rows = [
         {
             "kind": s.kind,
             "time": round(s.time - src.start_s, 4),
             "shown": s.shown,
             "fixed": s.fixed,
-            "moving_ms": round((s.drawn - s.moving_since) * 1e3, 1),  # type: ignore[operator]
+            "moving_ms": (
+                None if s.moving_since is None else round((s.drawn - s.moving_since) * 1e3, 1)
+            ),
             "lead_ms": round((s.impact - s.drawn) * 1e3, 1),  # left to the impact
             "new_hand_wrist_peak_m_s": (
                 round(_wrist_peak(a, s.fixed, s.drawn, s.impact), 2)
@@ -94,7 +97,7 @@ def measure(path: Path, max_seconds: float, pins: bool) -> dict[str, Any]:
         "taken_back": counts["taken_back"],
         "taken_back_moving": counts["taken_back_moving"],
         "dropped": int(perf.planner.report.summary().get("dropped", 0)),
-        "switches_moving": rows,
+        "switches": rows,
     }
 
 
@@ -116,11 +119,12 @@ def main(argv: list[str] | None = None) -> int:
             f"{r['revised_moving']} (of {r['revised']}), taken back "
             f"{r['taken_back_moving']} (of {r['taken_back']}); dropped {r['dropped']}"
         )
-        for w in r["switches_moving"]:
+        for w in r["switches"]:
             peak = w["new_hand_wrist_peak_m_s"]
+            moved = "not moving" if w["moving_ms"] is None else f"moving {w['moving_ms']:.0f} ms"
             print(
-                f"  {w['kind']:<10} {w['time']:8.3f} s {w['shown']} -> {w['fixed']}: moving "
-                f"{w['moving_ms']:.0f} ms, {w['lead_ms']:.0f} ms left"
+                f"  {w['kind']:<10} {w['time']:8.3f} s {w['shown']} -> {w['fixed']}: {moved}, "
+                f"{w['lead_ms']:.0f} ms left"
                 + ("" if peak is None else f", new hand's wrist peak {peak:.2f} m/s")
             )
     if args.json:

@@ -146,7 +146,7 @@ class Performance:
     def feed_routed(self, performer: Performer, event: Event, *, now_s: float) -> None:
         """An event already routed (jam's keyboard split does its own routing)."""
         if isinstance(event, NoteOn):
-            self._pin_shown()  # the planner commits what started before taking it in
+            self._pin_shown(now_s)  # the planner commits what started before taking it in
             known = getattr(self.animator, "note_known", None)
             if known is not None and performer == "drums":  # a free hand may start toward it
                 known(performer, event, now_s)
@@ -171,13 +171,13 @@ class Performance:
 
     def advance(self, now_s: float) -> list[PlannedNote]:
         """Commit the motions that have started by ``now_s``; log and animate them."""
-        self._pin_shown()
+        self._pin_shown(now_s)
         notes = self._commit(self.planner.poll(now_s))
         if any(p.performer == "drums" for p in notes):
             self._tell_provisional()
         return notes
 
-    def _pin_shown(self) -> None:
+    def _pin_shown(self, now_s: float) -> None:
         """Live: the notes whose provisional hand a sink has drawn moving
         (``shown_moving``), pinned to that hand in the plan (``pin_hands``) before the
         planner fixes anything: the commit keeps a hand shown moving on its note unless
@@ -190,7 +190,7 @@ class Performance:
             return
         pins = look()  # asked even when not pinned: the animator counts how they fare
         if self.pin_shown:
-            pin(pins)
+            pin(pins, now_s=now_s)
 
     def _tell_provisional(self) -> None:
         """The plan's current hands for the drum notes not yet started, to a sink that

@@ -15,6 +15,7 @@ left foot (:meth:`virja.plan.chain_feet.FootChain.chick`).  Shared rules:
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -35,6 +36,8 @@ BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
 BUZZ_S = 0.050
 BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
 
+# where a hand that has struck nothing yet waits: its ready pose, the stick over the snare
+REST_PIECE = "snare"
 _MARGIN_S = 1e-6  # the rebound rules look at notes this much further back, then test exactly
 
 # one solved group: the hand per stroke (None: dropped), their costs, the state after
@@ -69,7 +72,7 @@ def hand_group(
     group: list[DrumHeld],
     t0: float,
     chick: Callable[[float], bool] | None = None,
-    pinned: bool = False,
+    pin: Callable[[DrumHeld], tuple[Hand | None, float]] | None = None,
 ) -> HandGroupPlan:
     """The strokes of a group: notes of one piece within SAME_STROKE_S are one stroke.
 
@@ -80,8 +83,8 @@ def hand_group(
     third distinct piece within the window is more than two hands can strike.
     ``chick(t)``: whether the left foot can take a hi-hat stroke at ``t``
     (``Stroke.foot``: when both hands are busy, a closed hi-hat note is a chick).
-    ``pinned``: each stroke carries the hand drawn moving for it (``Stroke.pin``, live,
-    when the group is fixed).
+    ``pin(r)``: the hand drawn moving for note ``r`` and what giving it to the other
+    costs (``Stroke.pin``, ``Stroke.switch``; live only, :meth:`HandsChain.pin`).
     """
     if not group:
         return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
@@ -92,7 +95,7 @@ def hand_group(
             velocity_priority(r.drum.priority, r.note.velocity),
             r.note.time_s - t0,
             chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
-            r.pin if pinned else None,
+            *_pinned(pin, [r]),
         )
         return HandGroupPlan(drums_mod.HandGroup(t0, (stroke,)), [[r]], [], [])
     if len(group) == 2 and group[0].drum.piece != group[1].drum.piece:
@@ -110,7 +113,7 @@ def hand_group(
                         rank[0],
                         r.note.time_s - t0,
                         chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
-                        r.pin if pinned else None,
+                        *_pinned(pin, [r]),
                     )
                     for rank, r in pair
                 ),
@@ -164,11 +167,23 @@ def hand_group(
             prio[c[0].seq],
             c[0].note.time_s - t0,
             chick is not None and c[0].drum.piece == "hihat" and chick(c[0].note.time_s),
-            next((r.pin for r in c if r.pin is not None), None) if pinned else None,
+            *_pinned(pin, c),
         )
         for c in kept
     )
     return HandGroupPlan(drums_mod.HandGroup(t0, strokes), kept, bounces, extra)
+
+
+def _pinned(
+    pin: Callable[[DrumHeld], tuple[Hand | None, float]] | None, recs: list[DrumHeld]
+) -> tuple[Hand | None, float]:
+    """A stroke's ``Stroke.pin`` and ``Stroke.switch``: those of its first note with a
+    pin (none without ``pin``)."""
+    if pin is not None:
+        for r in recs:
+            if r.pin is not None:
+                return pin(r)
+    return None, 0.0
 
 
 class HandsChain(DrumChain):
@@ -180,6 +195,7 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
+        self.pin_now = -math.inf  # live: when the pins were last told (:meth:`pin`)
         # the groups and state :meth:`provisional` last solved, and its steps
         self._shown: (
             tuple[tuple[tuple[drums_mod.HandGroup, ...], drums_mod.HandState], list[HandStep]]
@@ -192,20 +208,51 @@ class HandsChain(DrumChain):
     def forget_plan(self) -> None:
         self.plan.forget()
 
-    def pin(self, pins: dict[tuple[int, int, float], Hand]) -> int:
-        """Live: the hand drawn moving for each pending note (by channel, note and time
-        rounded to 1e-9 s; plan.types.HandPin), the whole current set: a note not in it
-        has no pin.  A pin binds when its group is fixed, at its motion's start
-        (:meth:`fix_groups`): the other hand then costs ``shown_hand_penalty`` more
-        (drums.switch_penalty).  Returns how many pending notes have one."""
+    def pin(self, pins: dict[tuple[int, int, float], Hand], now_s: float) -> int:
+        """Live: the hand drawn moving for each pending note at ``now_s`` (by channel,
+        note and time rounded to 1e-9 s; plan.types.HandPin), the whole current set: a
+        note not in it has no pin.  The plan then gives a pinned note the other hand
+        only at :meth:`switch_cost` more.  Returns how many pending notes have one."""
+        self.pin_now = now_s
         n = 0
         for r in self.pending:
             hand = (
                 pins.get((r.note.channel, r.note.note, round(r.note.time_s, 9))) if pins else None
             )
-            r.pin = hand
+            if hand != r.pin:
+                r.pin = hand
+                self.forget_plan()
             n += hand is not None
+        if n:  # the price of a switch grows as the time left shrinks
+            self.forget_plan()
         return n
+
+    def switch_cost(self, rec: DrumHeld) -> tuple[Hand | None, float]:
+        """The pin of ``rec`` and what giving it to the other hand costs beyond the
+        table: ``shown_hand_penalty`` (drum_costs.toml), and what the speed that hand
+        needs costs (timing.toml [hand_speed], drums.stroke_penalty) when it leaves for
+        the note only now (:attr:`pin_now`), from the piece it struck last, over what the
+        plan charges it from that stroke.  A switch with time to spare costs little; one
+        at the motion's start (rest -> crash in 67 ms) the fastest tier."""
+        hand = rec.pin
+        if hand is None:
+            return None, 0.0
+        timing = self.ctx.config.timing
+        other = drums_mod.LEFT if hand == drums_mod.RIGHT else drums_mod.RIGHT
+        _prev, _pt, t_right, t_left, p_right, p_left = self.state
+        last, piece = (t_left, p_left) if other == drums_mod.LEFT else (t_right, p_right)
+        t, target = rec.note.time_s, rec.drum.piece
+        # what the plan charges that hand from its last stroke in the state (none: free)
+        charged = drums_mod.stroke_penalty(
+            timing, piece, target, math.inf if last is None else t - last
+        )
+        # where it is: over the piece it played last (its ready pose over the snare
+        # when it has played none), leaving now, or when that stroke lands
+        played = next((p for _ft, p in reversed(self.fixed) if p.limb == other), None)
+        where = played.piece if played is not None and played.piece else REST_PIECE
+        leaves = self.pin_now if played is None else max(self.pin_now, played.impact)
+        rushed = drums_mod.stroke_penalty(timing, where, target, t - leaves)
+        return hand, self.ctx.config.costs.shown_hand_penalty + max(0.0, rushed - charged)
 
     def _rebounds(self, groups: list[list[DrumHeld]], decide: bool = True) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
@@ -306,11 +353,6 @@ class HandsChain(DrumChain):
         aside = rebounds | {r.seq for r in self.pending if r.to_foot}
 
         prepared: dict[int, HandGroupPlan] = {}  # by the group's first note, made once
-        # live: the groups fixed now carry the hands drawn moving for their notes (pin);
-        # the plan kept for them was made without, so it is solved again
-        fixing = {g[0].seq for g in groups[:n_groups]}
-        if any(r.pin is not None for g in groups[:n_groups] for r in g):
-            self.plan.forget()
 
         def prepare(g: list[DrumHeld]) -> HandGroupPlan:
             hp = prepared.get(g[0].seq)
@@ -319,7 +361,7 @@ class HandsChain(DrumChain):
                     [r for r in g if r.seq not in aside],
                     g[0].note.time_s,
                     self.foot.can_chick,
-                    g[0].seq in fixing,
+                    self.switch_cost,
                 )
             return hp
 
@@ -357,7 +399,12 @@ class HandsChain(DrumChain):
         held = self.plan.held()
         n = min(len(groups), len(held) if held else self.ctx.bounds.window_groups)
         hps = [
-            hand_group([r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick)
+            hand_group(
+                [r for r in g if r.seq not in aside],
+                g[0].note.time_s,
+                self.foot.can_chick,
+                self.switch_cost,
+            )
             for g in groups[:n]
         ]
         steps = held if held else self._solved([hp.group for hp in hps])

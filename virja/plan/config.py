@@ -150,7 +150,7 @@ class DrumCosts:
     drop_penalty: float
     # live only: a note given the other hand than the one drawn moving for it
     # (``Stroke.pin``, drum_costs.toml)
-    shown_hand_penalty: float = 200.0
+    shown_hand_penalty: float = 4.0
     _rows: dict[tuple[str, str], int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -321,7 +321,7 @@ class CostsFile(Schema):
     motions: list[str]
     rows: dict[str, dict[str, float]]
     drop_penalty: float = 1000.0
-    shown_hand_penalty: float = 200.0
+    shown_hand_penalty: float = 4.0
 
 
 class HandMoveTable(Schema):

@@ -17,8 +17,8 @@ it needs, by tiers (distance / time since the hand's last stroke, timing.toml
 dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping happens only
 when nothing else is feasible.  Ties go to the right hand (the time-keeping hand
 keeps the time).  Live, a stroke whose provisional hand is already drawn moving for it
-(``Stroke.pin``) costs ``shown_hand_penalty`` more with the other hand
-(:func:`switch_penalty`): kept unless that would drop a note.
+(``Stroke.pin``) costs more with the other hand (``Stroke.switch``,
+:func:`switch_penalty`), which can leave for it only now.
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """
@@ -48,9 +48,10 @@ class Stroke:
     priority: int
     dt: float = 0.0  # its note's time after the group's time (within the grouping window)
     foot: bool = False  # a hi-hat stroke the left foot can take (a chick on the pedal)
-    # live only: the hand drawn moving for it already (a pin, plan.types.HandPin); the
-    # other hand costs ``DrumCosts.shown_hand_penalty`` more (:func:`switch_penalty`)
+    # live only: the hand drawn moving for it already (a pin, plan.types.HandPin), and
+    # what giving it to the other hand costs more (:func:`switch_penalty`)
     pin: Hand | None = None
+    switch: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -113,13 +114,14 @@ def unplayed_penalty(
     return drop_penalty(costs, strokes[i])
 
 
-def switch_penalty(costs: DrumCosts, stroke: Stroke, hand: Hand | None) -> float:
+def switch_penalty(stroke: Stroke, hand: Hand | None) -> float:
     """What giving ``stroke`` to ``hand`` costs beyond the table because another hand
-    was drawn moving for it (``Stroke.pin``, live only): ``shown_hand_penalty`` for
-    the other hand, nothing for the pinned one or a drop (which pays its own)."""
+    was drawn moving for it (``Stroke.pin``, live only): ``Stroke.switch`` for the other
+    hand (virja.plan.chain_hands prices it: the other hand leaves only now), nothing
+    for the pinned one or a drop (which pays its own)."""
     if stroke.pin is None or hand is None or hand == stroke.pin:
         return 0.0
-    return costs.shown_hand_penalty
+    return stroke.switch
 
 
 def _steps(timing: Timing, prev: str | None, piece: str) -> tuple[tuple[float, float], ...]:
@@ -182,7 +184,7 @@ def transition(
         if hand is None:
             total += unplayed_penalty(costs, timing, group.strokes, assign, i)
         elif group.strokes[i].pin is not None:
-            total += switch_penalty(costs, group.strokes[i], hand)
+            total += switch_penalty(group.strokes[i], hand)
     if order:
         prev, prev_t = row, t
     return total, (prev, prev_t, t_right, t_left, p_right, p_left), tuple(per)
@@ -357,7 +359,7 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
                 penalty += unplayed_penalty(costs, timing, strokes, assign, i)
             else:
                 if stroke.pin is not None:  # live: another hand drawn moving for it
-                    penalty += switch_penalty(costs, stroke, hand)
+                    penalty += switch_penalty(stroke, hand)
                 played.append(
                     (hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, stroke.dt, i)
                 )

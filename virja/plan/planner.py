@@ -158,16 +158,20 @@ class OnlinePlanner:
         else:
             raise ValueError(f"unknown performer {performer!r}")
 
-    def pin_hands(self, pins: Iterable[HandPin]) -> int:
-        """Live: the drum notes whose provisional hand is drawn moving for them now (the
-        animator says which, ``BandAnimator.shown_moving``; the performance passes the
-        whole current set before each commit).  When such a note's group is fixed, at
-        its motion's start, the plan keeps that hand unless only the other plays it, or
-        another note, in time (``shown_hand_penalty``, below a drop: docs/motion.md,
-        round 8).  Before that the plan may still give it the other hand, which then
-        has more than the lead.  Returns how many pending notes have a pin.  Whole-input
-        planning (``run_schedule``) draws nothing and pins none: its plans are unchanged."""
-        return self._hands.pin({(p.channel, p.note, round(p.time_s, 9)): p.hand for p in pins})
+    def pin_hands(self, pins: Iterable[HandPin], *, now_s: float) -> int:
+        """Live: the drum notes whose provisional hand is drawn moving for them at
+        ``now_s`` (the animator says which, ``BandAnimator.shown_moving``; the
+        performance passes the whole current set before each commit).  The plan then
+        gives such a note the other hand only at a price: what that hand's speed costs
+        when it leaves only now, plus ``shown_hand_penalty``
+        (:meth:`virja.plan.chain_hands.HandsChain.switch_cost`): with time to spare the
+        plan may still switch, at the motion's start it keeps the hand shown unless it
+        cannot play the note in time or that would drop a note.  Returns how many pending
+        notes have a pin.  Whole-input planning (``run_schedule``) draws nothing and pins
+        none: its plans are unchanged (docs/motion.md, round 8)."""
+        return self._hands.pin(
+            {(p.channel, p.note, round(p.time_s, 9)): p.hand for p in pins}, now_s
+        )
 
     # -- outputs --------------------------------------------------------------
 

@@ -253,3 +253,31 @@ def test_as_live_no_note_is_taken_from_a_hand_drawn_moving_toward_it() -> None:
     assert counts["shown"] > 10 and counts["fixed_same_moving"] >= 2
     assert counts["revised_moving"] == 0
     assert perf.planner.report.summary()["dropped"] == 0
+
+
+def test_a_hand_frozen_just_before_the_others_impact_does_not_step_aside() -> None:
+    """GMD drummer5 merengue 162 (5/8), the first 7.5 s as live: a right-hand snare
+    stroke shown at 6.73 s and revised to the left at 6.80 s froze the right hand's
+    track there, 23 ms before the left's snare stroke, and the hand got out of its way
+    from there: 12 cm aside in 12 ms (12.5 m/s).  Getting out of the way needs
+    _YIELD_MIN_S from where the track is frozen too; every wrist stays under 5 m/s."""
+    path = (
+        ROOT
+        / "tests"
+        / "data"
+        / "gmd"
+        / "drummer5_session1_8_latin-venezuelan-merengue_162_beat_5-8.mid"
+    )
+    settings = PerformanceSettings()
+    perf, _planned = perform(
+        settings,
+        midi_input(path, settings.routing, 1.0),
+        animate=True,
+        until_s=7.5,
+        as_live_fps=30.0,
+    )
+    a = perf.animator
+    assert isinstance(a, BandAnimator)
+    assert a.provisional_counts["revised"] >= 1
+    w = _wrists(a, np.arange(6.5, 7.3, 1 / 600))
+    assert np.linalg.norm(np.diff(w, axis=0), axis=-1).max() * 600 < 5.0

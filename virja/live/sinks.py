@@ -68,9 +68,9 @@ class Fanout:
                 call(notes)
 
     def shown_moving(self) -> list[HandPin]:
-        """The provisional strokes newly drawn moving by the sinks that draw a drummer on
-        this side (the web feed's animator; the window's process draws its own, out of
-        reach): what the performance pins for the planner."""
+        """The provisional strokes drawn moving (the whole current set) by the sinks that
+        draw a drummer on this side (the web feed's animator; the window's process draws
+        its own, out of reach): what the performance pins for the planner."""
         out: list[HandPin] = []
         for s in self.sinks:
             call = getattr(s, "shown_moving", None)

@@ -120,7 +120,8 @@ def perform(
     Returns the performance (its planner's report, its animator) and every planned note
     in commit order; ``plan``, ``motion-report`` and the capture tools plan here, so their
     plans are the ones render draws.  ``as_live_fps``: instead, frames of ``1/fps`` drawn
-    as the live window draws them (:func:`virja.session.run_as_live`; the same plan),
+    as the live window draws them (:func:`virja.session.run_as_live`; the same plan but
+    for notes whose hand was drawn moving, kept for them),
     so the animator ends with the motion the window showed."""
     from virja.events import NoteOn
     from virja.session import run_as_live, run_schedule

@@ -87,6 +87,10 @@ class Performance:
         # drawn before the end (run_schedule: the whole input known)
         self.tell_provisional = True
         self._provisional: list[PlannedNote] = []
+        # live: the hands drawn moving for notes not yet fixed, asked of a sink that
+        # draws them (shown_moving) and pinned in the plan before each commit
+        # (OnlinePlanner.pin_hands); off, a live plan is the whole input's
+        self.pin_shown = True
 
     @property
     def animator(self) -> PlanSink | None:
@@ -142,6 +146,7 @@ class Performance:
     def feed_routed(self, performer: Performer, event: Event, *, now_s: float) -> None:
         """An event already routed (jam's keyboard split does its own routing)."""
         if isinstance(event, NoteOn):
+            self._pin_shown(now_s)  # the planner commits what started before taking it in
             known = getattr(self.animator, "note_known", None)
             if known is not None and performer == "drums":  # a free hand may start toward it
                 known(performer, event, now_s)
@@ -166,10 +171,26 @@ class Performance:
 
     def advance(self, now_s: float) -> list[PlannedNote]:
         """Commit the motions that have started by ``now_s``; log and animate them."""
+        self._pin_shown(now_s)
         notes = self._commit(self.planner.poll(now_s))
         if any(p.performer == "drums" for p in notes):
             self._tell_provisional()
         return notes
+
+    def _pin_shown(self, now_s: float) -> None:
+        """Live: the notes whose provisional hand a sink has drawn moving
+        (``shown_moving``), pinned to that hand in the plan (``pin_hands``) before the
+        planner fixes anything: the commit keeps a hand shown moving on its note unless
+        it cannot play it.  Not where nothing is drawn meanwhile (``run_schedule``)."""
+        if not self.tell_provisional:
+            return
+        look = getattr(self.animator, "shown_moving", None)
+        pin = getattr(self.planner, "pin_hands", None)
+        if look is None or pin is None:
+            return
+        pins = look()  # asked even when not pinned: the animator counts how they fare
+        if self.pin_shown:
+            pin(pins, now_s=now_s)
 
     def _tell_provisional(self) -> None:
         """The plan's current hands for the drum notes not yet started, to a sink that
@@ -318,7 +339,9 @@ def run_as_live(
     started committed, and the frame marked drawn (``mark_drawn``): a later plan
     changes nothing up to there, so the animator ends with the motion the window
     showed.  Runs until every event is fed and every note has sounded; returns
-    every planned note, in commit order (the plan equals :func:`run_schedule`'s)."""
+    every planned note, in commit order.  The plan equals :func:`run_schedule`'s but for
+    the notes whose provisional hand was drawn moving when the plan would have given
+    them the other (``Performance.pin_shown``: kept unless that drops a note)."""
     feeder = RevealFeeder(schedule)
     end_s = max((r.event.time_s for r in schedule), default=t0_s)
     start_s = min([t0_s, *(r.at_s for r in schedule[:1])])

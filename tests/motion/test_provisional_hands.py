@@ -5,20 +5,27 @@ drawn and re-targets the hands from where they are."""
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 from tests.motion.helpers import assert_same_frames, drum
-from virja.events import NoteOn
+from virja.events import Beat, NoteOn
 from virja.geometry import GEOMETRY
+from virja.input import midi_input
 from virja.motion.band import BandAnimator, sticks
 from virja.motion.clip import MotionLibrary
 from virja.motion.drummer_body import BodySettings
 from virja.motion.drummer_hands import HandSettings
 from virja.motion.metrics import contact_distance
 from virja.motion.skeleton import SKELETON
+from virja.pipeline import PerformanceSettings, perform
+from virja.plan.planner import OnlinePlanner
 from virja.plan.types import PlannedNote
+from virja.routing import Router
+from virja.session import Performance, Reveal, run_as_live
 
+ROOT = Path(__file__).resolve().parents[2]
 LEAD = 0.06  # the planned lead at 300 bpm: too short to cross the kit
 
 
@@ -186,3 +193,91 @@ def test_with_nothing_drawn_the_provisional_hands_leave_no_trace(library: Motion
         b.add_planned(p)
     ts = np.arange(0.2, 3.0, 1 / 60)
     np.testing.assert_array_equal(a.local_rotations_many(ts), b.local_rotations_many(ts))
+
+
+def _live(library: MotionLibrary, pins: bool) -> tuple[BandAnimator, dict[int, PlannedNote]]:
+    """At 300 bpm: a crash known 0.2 s ahead (the right hand, from rest, is shown moving
+    toward it), then a ride 60 ms after it known only 6 ms before the crash's motion
+    starts; played as the live window draws it (30 fps), hands drawn moving pinned in
+    the plan or not."""
+    a = _animator(library)
+    perf = Performance(router=Router(), planner=OnlinePlanner(), animator=a)
+    perf.pin_shown = pins
+    beats = [Reveal(0.0, Beat(0.2 * k, k // 4, k % 4 + 1, 4, 0, 200_000)) for k in range(12)]
+    notes = [Reveal(1.3, NoteOn(1.5, 9, 49, 100)), Reveal(1.39, NoteOn(1.56, 9, 51, 90))]
+    planned = run_as_live(perf, beats + notes, 30.0, 0.0)
+    return a, {p.note: p for p in planned}
+
+
+def test_a_hand_drawn_moving_keeps_its_note_at_the_motions_start(library: MotionLibrary) -> None:
+    """The unit case of round 7 through the planner: the right hand has been drawn on
+    its way from rest to the crash when a late ride makes the left hand the cheaper
+    crash hand by the table; on main the plan gave the crash to the left 6 ms before its
+    motion started (110 ms before it sounds), the right turned back.  Now the plan
+    keeps the crash on the right (the other hand would leave only then: the speed tier
+    it needs costs more than the crossing), the late ride goes to the free left hand,
+    and no wrist passes 8 m/s."""
+    a, planned = _live(library, pins=True)
+    assert planned[49].limb == "right_hand"
+    assert a.provisional_counts["fixed_other"] == 0
+    assert a.provisional_counts["revised_moving"] == 0
+    assert a.provisional_counts["fixed_same_moving"] >= 1  # it was drawn moving
+    w = _wrists(a, np.arange(1.2, 1.7, 1 / 600))
+    assert np.linalg.norm(np.diff(w, axis=0), axis=-1).max() * 600 <= 8.0
+    for p in planned.values():
+        assert contact_distance(a, p, p.impact)[0] < 1e-4
+    b, free = _live(library, pins=False)  # not pinned: the left takes the crash
+    assert free[49].limb == "left_hand" and b.provisional_counts["revised_moving"] == 1
+
+
+def test_as_live_no_note_is_taken_from_a_hand_drawn_moving_toward_it() -> None:
+    """GMD drummer5 afro-cuban calypso 124, the first 2 s as live (motion-report
+    --as-live): on main the plan gave two notes the left hand at their motion's start
+    (0.36 and 1.32 s) after the right had been drawn moving toward them for 118-133 ms.
+    Now no note of a hand drawn moving goes to the other hand, nor is revised away."""
+    path = (
+        ROOT / "tests" / "data" / "gmd" / "drummer5_session1_13_afrocuban-calypso_124_beat_4-4.mid"
+    )
+    settings = PerformanceSettings()
+    perf, planned = perform(
+        settings,
+        midi_input(path, settings.routing, 1.0),
+        animate=True,
+        until_s=2.0,
+        as_live_fps=30.0,
+    )
+    a = perf.animator
+    assert isinstance(a, BandAnimator)
+    counts = a.provisional_counts
+    assert counts["fixed_other"] == 0  # main: 2
+    assert counts["shown"] > 10 and counts["fixed_same_moving"] >= 2
+    assert counts["revised_moving"] == 0
+    assert perf.planner.report.summary()["dropped"] == 0
+
+
+def test_a_hand_frozen_just_before_the_others_impact_does_not_step_aside() -> None:
+    """GMD drummer5 merengue 162 (5/8), the first 7.5 s as live: a right-hand snare
+    stroke shown at 6.73 s and revised to the left at 6.80 s froze the right hand's
+    track there, 23 ms before the left's snare stroke, and the hand got out of its way
+    from there: 12 cm aside in 12 ms (12.5 m/s).  Getting out of the way needs
+    _YIELD_MIN_S from where the track is frozen too; every wrist stays under 5 m/s."""
+    path = (
+        ROOT
+        / "tests"
+        / "data"
+        / "gmd"
+        / "drummer5_session1_8_latin-venezuelan-merengue_162_beat_5-8.mid"
+    )
+    settings = PerformanceSettings()
+    perf, _planned = perform(
+        settings,
+        midi_input(path, settings.routing, 1.0),
+        animate=True,
+        until_s=7.5,
+        as_live_fps=30.0,
+    )
+    a = perf.animator
+    assert isinstance(a, BandAnimator)
+    assert a.provisional_counts["revised"] >= 1
+    w = _wrists(a, np.arange(6.5, 7.3, 1 / 600))
+    assert np.linalg.norm(np.diff(w, axis=0), axis=-1).max() * 600 < 5.0

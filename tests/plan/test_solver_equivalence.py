@@ -79,6 +79,7 @@ def _reference_drums(
                 if hand is None:
                     penalty += drums.unplayed_penalty(costs, timing, group.strokes, assign, i)
                 else:
+                    penalty += drums.switch_penalty(stroke, hand)  # live pins: 0 without
                     plays.append((hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, i))
             plays.sort(key=lambda p: p[0])  # left hand first
             compiled.append((assign, tuple(plays), penalty))
@@ -363,3 +364,33 @@ def test_bass_solver_equals_the_plain_viterbi_with_fingerings_gaps_and_memoised_
         assert bass.solve(state, groups, fingering, gaps) == _reference_bass(
             state, groups, fingering, gaps
         )
+
+
+def test_drum_solver_with_pins_equals_the_plain_dp(config: PlanConfig) -> None:
+    """Live pins (``Stroke.pin``, ``Stroke.switch``: the other hand costs more) in the
+    compiled options and the C kernel as in the plain DP's :func:`drums.transition`."""
+    rng = random.Random(515)
+    pinned = 0
+    for _ in range(300):
+        costs, timing, state, groups = _random_case(rng, config)
+        groups = [
+            HandGroup(
+                g.time,
+                tuple(
+                    dataclasses.replace(
+                        s,
+                        pin=rng.choice([drums.LEFT, drums.RIGHT]),
+                        switch=rng.choice([4.0, 34.0, 324.0, 2000.0]),
+                    )
+                    if rng.random() < 0.5
+                    else s
+                    for s in g.strokes
+                ),
+            )
+            for g in groups
+        ]
+        pinned += any(s.pin for g in groups for s in g.strokes)
+        assert drums.solve(costs, timing, state, groups) == _reference_drums(
+            costs, timing, state, groups
+        )
+    assert pinned > 100

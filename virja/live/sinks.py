@@ -13,7 +13,7 @@ from typing import Any
 
 from virja.events import Beat, Chord, NoteOff, NoteOn
 from virja.motion.pose import BandPose
-from virja.plan.types import PlannedNote
+from virja.plan.types import HandPin, PlannedNote
 from virja.session import PlanSink
 from virja.vocab import Performer
 
@@ -66,6 +66,17 @@ class Fanout:
             call = getattr(s, "note_provisional", None)
             if call is not None:
                 call(notes)
+
+    def shown_moving(self) -> list[HandPin]:
+        """The provisional strokes drawn moving (the whole current set) by the sinks that
+        draw a drummer on this side (the web feed's animator; the window's process draws
+        its own, out of reach): what the performance pins for the planner."""
+        out: list[HandPin] = []
+        for s in self.sinks:
+            call = getattr(s, "shown_moving", None)
+            if call is not None:
+                out.extend(call())
+        return out
 
     def add_beat(self, beat: Beat) -> None:
         for s in self.sinks:

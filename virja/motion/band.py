@@ -42,6 +42,7 @@ from virja.motion.skeleton import (
     STICK_TIP_M,
 )
 from virja.motion.timeline import Instance, Timeline, blend_many
+from virja.plan.types import HandPin
 from virja.vocab import (
     ALL_BASS_STRINGS,
     BASS_STRINGS,
@@ -51,6 +52,7 @@ from virja.vocab import (
     PERFORMER_LIMBS,
     BassPluck,
     DrumStroke,
+    Hand,
     MotionKey,
     Performer,
     idle_clip,
@@ -182,6 +184,10 @@ class BandAnimator:
         # by note: (hand, the provisional note); and how they fared (provisional_counts)
         self._provisional: dict[tuple[str, int, int, float], tuple[str, PlannedNoteLike]] = {}
         self.provisional_counts: Counter[str] = Counter()
+        # provisional strokes drawn moving (shown_moving): by note, the hand and since when
+        self._moving: dict[tuple[str, int, int, float], tuple[str, float]] = {}
+        # each note the plan fixed to another hand than the one shown (how it fared live)
+        self.hand_switches: list[HandSwitch] = []
 
     def set_articulations(self, articulations: Mapping[int, str | None]) -> None:
         """The kit map's articulation per drum note number (``PlanConfig.kit.notes``):
@@ -256,7 +262,22 @@ class BandAnimator:
             if p is None or not _same_stroke(old, p):
                 self.hands.remove_stroke(hand, key, self.drawn_until)
                 del self._provisional[key]
-                self.provisional_counts["revised" if p is not None else "taken_back"] += 1
+                kind = "revised" if p is not None else "taken_back"
+                self.provisional_counts[kind] += 1
+                moving = self._moving.pop(key, None)
+                if moving is not None:
+                    self.provisional_counts[f"{kind}_moving"] += 1
+                    self.hand_switches.append(
+                        HandSwitch(
+                            kind,
+                            old.time,
+                            old.impact,
+                            hand,
+                            None if p is None else p.limb,
+                            moving[1],
+                            self.drawn_until,
+                        )
+                    )
         for key, p in new.items():
             if key in self._provisional or not isinstance(p.motion, DrumStroke):
                 continue
@@ -271,6 +292,27 @@ class BandAnimator:
             )
             self._provisional[key] = (hand, p)
             self.provisional_counts["shown"] += 1
+
+    def shown_moving(self) -> list[HandPin]:
+        """The provisional strokes drawn moving: their hand has moved toward them
+        (``DrummerHands.departs``) at or before the latest frame shown
+        (:attr:`drawn_until`), the whole current set, as pins for the planner
+        (``OnlinePlanner.pin_hands``: ``session.Performance`` passes them on before each
+        commit).  Nothing drawn (the whole input known): none."""
+        out: list[HandPin] = []
+        drawn = self.drawn_until
+        if drawn == -math.inf:
+            return out
+        for key, (hand, _p) in self._provisional.items():
+            moving = self._moving.get(key)
+            if moving is None:
+                since = self.hands.departs(hand, key)
+                if since is None or since > drawn:
+                    continue
+                moving = self._moving[key] = (hand, since)
+            side: Hand = "left_hand" if hand == "left_hand" else "right_hand"
+            out.append(HandPin(key[1], key[2], key[3], side, moving[1]))
+        return out
 
     def add_planned(self, p: PlannedNoteLike, known_at: float | None = None) -> None:
         """Schedule the motions of one planned note (its start and impact are kept exactly).
@@ -309,6 +351,8 @@ class BandAnimator:
             art = self.articulations.get(p.note)
             course = self._course(p.start, known_at)
             shown = self._provisional.pop(key, None)
+            if shown is not None and key in self._moving and shown[0] == limb:
+                self.provisional_counts["fixed_same_moving"] += 1
             if shown is not None and shown[0] == limb and _same_stroke(shown[1], p):
                 self.hands.keep_stroke(limb, key)  # the stroke shown is the one played
                 self.provisional_counts["fixed_same"] += 1
@@ -316,6 +360,20 @@ class BandAnimator:
                 if shown is not None:  # the plan fixed the other hand (or another stroke)
                     self.hands.remove_stroke(shown[0], key, self.drawn_until)
                     self.provisional_counts["fixed_other"] += 1
+                    moving = self._moving.get(key)
+                    if moving is not None:
+                        self.provisional_counts["fixed_other_moving"] += 1
+                    self.hand_switches.append(
+                        HandSwitch(
+                            "fixed",
+                            p.time,
+                            p.impact,
+                            shown[0],
+                            limb,
+                            None if moving is None else moving[1],
+                            self.drawn_until,
+                        )
+                    )
                 self.hands.add_stroke(
                     limb, course, p.impact, clip, p.velocity, art, drawn=self.drawn_until
                 )
@@ -378,6 +436,7 @@ class BandAnimator:
         self.hands.forget_before(time_s)
         self._known = {k: v for k, v in self._known.items() if k[3] >= time_s - 10.0}
         self._provisional = {k: v for k, v in self._provisional.items() if k[3] >= time_s - 10.0}
+        self._moving = {k: v for k, v in self._moving.items() if k[3] >= time_s - 10.0}
         self.hihat.forget_before(time_s)
         horizon = time_s - 10.0  # kit and string states have died away long before
         self.bassist.forget_before(horizon)
@@ -655,6 +714,23 @@ class BandAnimator:
                     out[inst.clip.string] = inst.clip.fret
                 break
         return out
+
+
+@dataclass(frozen=True, slots=True)
+class HandSwitch:
+    """A drum note the plan took from the hand shown for it: ``kind`` "fixed" (to
+    another limb), or, for a hand drawn moving already, "revised" (another stroke shown)
+    or "taken_back" (none: a foot's chick, a rebound); its time and impact, the hand
+    shown and the limb given it (None: taken back), since when the shown hand was drawn
+    moving for it (None: not yet), and the latest frame shown then."""
+
+    kind: str
+    time: float
+    impact: float
+    shown: str
+    fixed: str | None
+    moving_since: float | None
+    drawn: float
 
 
 def _note_key(p: Any) -> tuple[str, int, int, float]:

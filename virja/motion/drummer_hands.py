@@ -94,6 +94,9 @@ _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
 _REACH_MIN_S = 0.04
+# a stroke whose piece lies this far from where the hand is moves the hand toward it
+# (DrummerHands.departs); nearer, only the stick's backswing shows it (the hand stays)
+_DEPART_M = 0.02
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
 
 
@@ -385,6 +388,9 @@ class DrummerHands:
         self._lifts: dict[str, list[drummer_clear.Detour]] = {h: [] for h in HANDS}
         self._detour_src: tuple[_Keys | None, ...] | None = None
         self._drawn = -math.inf
+        # per stroke added under a key, from the last build: when the hand's track first
+        # moves for it (:meth:`departs`)
+        self._departs: dict[str, dict[object, float]] = {h: {} for h in HANDS}
 
     @property
     def enabled(self) -> bool:
@@ -653,7 +659,10 @@ class DrummerHands:
             square to the other stick at its impact, to this hand's side of it, if the other hand strikes there before
             ``nxt`` (:meth:`_yield`)."""
             yielding = self._yield(hand, t, piece, nxt, row)
-            if yielding is None or max(yielding[0], floor) >= yielding[1]:
+            # the time left from where the track is frozen (live) counts, as in _yield: a
+            # hand frozen 23 ms before the other's impact stepped 12 cm aside in 12 ms
+            # (as live, GMD merengue 162 at 6.8 s: 12.5 m/s, after a revised stroke)
+            if yielding is None or yielding[1] - max(yielding[0], floor) < _YIELD_MIN_S:
                 return
             at, t_o, (tip_o, grip_o) = max(yielding[0], floor), yielding[1], yielding[2]
             here = _cut(pt, pv, pp, at, _pose_at)  # never before what is frozen
@@ -689,6 +698,9 @@ class DrummerHands:
                 nxt = next((u for u in times if u > floor), math.inf)
                 get_out_of_the_way(prev_t, prev_piece, nxt, base.last[2])
         strokes = self._strokes[hand]
+        ids = self._ids[hand]
+        departs: dict[object, float] = {}
+        aimed: dict[int, float] = {}  # a stroke toward which the one before was aimed, from
         for i, (t, (start, pose, vel, art)) in enumerate(zip(times, strokes, strict=True)):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
@@ -723,6 +735,8 @@ class DrummerHands:
                 nxt_pose = strokes[j][1]
                 nxt_row = np.concatenate([nxt_pose.grip, nxt_pose.rot, nxt_pose.elbow])
                 reached = self._reached(hand, target, nxt_row, times[j] - t, 0.5)
+                if reached is not target and ids[j] is not None:
+                    aimed[j] = max(strokes[j][0], cut)
             down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
             down = min(down, 0.5 * room) if room > 0 else 0.0
             rise = min(2 * down + 0.05, 0.5 * gap)
@@ -763,6 +777,11 @@ class DrummerHands:
                     _add(lt, lv, lp, t - down - rise, lift_here, _SMOOTH)
                 _add(lt, lv, lp, t - down, lift, _SMOOTH)
             _add(lt, lv, lp, t, 0.0, _ACCEL)
+            if ids[i] is not None:  # when the hand first moves toward it (departs)
+                moves = (leave if leave > cut + 1e-4 else cut) if way >= _DEPART_M else math.inf
+                first = min(moves, aimed.get(i, math.inf))
+                if first < math.inf:
+                    departs[ids[i]] = first
             # the tail, as if no stroke followed: rebound to a hover, rest after a while
             hover = min(s.hover_m, lift, prev_lift if prev_t is not None else lift)
             away = t + 0.5 * s.rest_after_s
@@ -777,6 +796,7 @@ class DrummerHands:
             prev_t, prev_lift, prev_piece = t, lift, pose.piece
             landed.append((t, lift, target, pose.piece))
         self._lists[hand] = (pt, pv, pp, lt, lv, lp, landed)
+        self._departs[hand] = departs
         rows = np.array(pv)
         seg = [_segment(*k) for k in zip(pp, pt, pv, strict=True)]
         lseg = [_segment(*k) for k in zip(lp, lt, lv, strict=True)]
@@ -828,6 +848,18 @@ class DrummerHands:
         _add(lt, lv, lp, away + s.rest_move_s, 0.0, _SMOOTH)
         _add(pt, pv, pp, away, target, _SMOOTH)
         _add(pt, pv, pp, away + s.rest_move_s, home, _MOVE)
+
+    def departs(self, hand: str, key: object) -> float | None:
+        """When ``hand`` first moves toward the piece of the stroke added under ``key``:
+        its move there begins (a piece at least _DEPART_M from where the hand is), or the
+        stroke before it is aimed toward it (the stick's reach).  None when ``hand`` has no
+        such stroke, or it moves only the stick (a stroke where the hand is: a backswing,
+        which a plan giving the note to the other hand only lowers again).  A frame drawn
+        at or after it has shown the hand on its way to that stroke."""
+        if key not in self._ids.get(hand, ()):
+            return None
+        self.keys(hand)
+        return self._departs[hand].get(key)
 
     def keys(self, hand: str) -> _Keys | None:
         if not self._times[hand] and self._base[hand] is None:

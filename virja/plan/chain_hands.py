@@ -15,6 +15,7 @@ left foot (:meth:`virja.plan.chain_feet.FootChain.chick`).  Shared rules:
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -24,6 +25,7 @@ from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
 from virja.plan.types import PlannedNote
+from virja.vocab import Hand
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
 # double trigger): the later ones ride on the first stroke, each at its own time.
@@ -34,6 +36,8 @@ BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
 BUZZ_S = 0.050
 BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
 
+# where a hand that has struck nothing yet waits: its ready pose, the stick over the snare
+REST_PIECE = "snare"
 _MARGIN_S = 1e-6  # the rebound rules look at notes this much further back, then test exactly
 
 # one solved group: the hand per stroke (None: dropped), their costs, the state after
@@ -65,7 +69,10 @@ class HandGroupPlan:
 
 
 def hand_group(
-    group: list[DrumHeld], t0: float, chick: Callable[[float], bool] | None = None
+    group: list[DrumHeld],
+    t0: float,
+    chick: Callable[[float], bool] | None = None,
+    pin: Callable[[DrumHeld], tuple[Hand | None, float]] | None = None,
 ) -> HandGroupPlan:
     """The strokes of a group: notes of one piece within SAME_STROKE_S are one stroke.
 
@@ -76,6 +83,8 @@ def hand_group(
     third distinct piece within the window is more than two hands can strike.
     ``chick(t)``: whether the left foot can take a hi-hat stroke at ``t``
     (``Stroke.foot``: when both hands are busy, a closed hi-hat note is a chick).
+    ``pin(r)``: the hand drawn moving for note ``r`` and what giving it to the other
+    costs (``Stroke.pin``, ``Stroke.switch``; live only, :meth:`HandsChain.pin`).
     """
     if not group:
         return HandGroupPlan(drums_mod.HandGroup(t0, ()), [], [], [])
@@ -86,6 +95,7 @@ def hand_group(
             velocity_priority(r.drum.priority, r.note.velocity),
             r.note.time_s - t0,
             chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+            *_pinned(pin, [r]),
         )
         return HandGroupPlan(drums_mod.HandGroup(t0, (stroke,)), [[r]], [], [])
     if len(group) == 2 and group[0].drum.piece != group[1].drum.piece:
@@ -103,6 +113,7 @@ def hand_group(
                         rank[0],
                         r.note.time_s - t0,
                         chick is not None and r.drum.piece == "hihat" and chick(r.note.time_s),
+                        *_pinned(pin, [r]),
                     )
                     for rank, r in pair
                 ),
@@ -156,10 +167,23 @@ def hand_group(
             prio[c[0].seq],
             c[0].note.time_s - t0,
             chick is not None and c[0].drum.piece == "hihat" and chick(c[0].note.time_s),
+            *_pinned(pin, c),
         )
         for c in kept
     )
     return HandGroupPlan(drums_mod.HandGroup(t0, strokes), kept, bounces, extra)
+
+
+def _pinned(
+    pin: Callable[[DrumHeld], tuple[Hand | None, float]] | None, recs: list[DrumHeld]
+) -> tuple[Hand | None, float]:
+    """A stroke's ``Stroke.pin`` and ``Stroke.switch``: those of its first note with a
+    pin (none without ``pin``)."""
+    if pin is not None:
+        for r in recs:
+            if r.pin is not None:
+                return pin(r)
+    return None, 0.0
 
 
 class HandsChain(DrumChain):
@@ -171,15 +195,64 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
-        # the steps of the latest solves by group time, with the group and the state
-        # it was solved from: what :meth:`provisional` reuses rather than solving again
-        self._seen: dict[float, tuple[drums_mod.HandGroup, drums_mod.HandState, HandStep]] = {}
+        self.pin_now = -math.inf  # live: when the pins were last told (:meth:`pin`)
+        # the groups and state :meth:`provisional` last solved, and its steps
+        self._shown: (
+            tuple[tuple[tuple[drums_mod.HandGroup, ...], drums_mod.HandState], list[HandStep]]
+            | None
+        ) = None
 
     def kind(self, drum: DrumNote) -> str:
         return drum.piece
 
     def forget_plan(self) -> None:
         self.plan.forget()
+
+    def pin(self, pins: dict[tuple[int, int, float], Hand], now_s: float) -> int:
+        """Live: the hand drawn moving for each pending note at ``now_s`` (by channel,
+        note and time rounded to 1e-9 s; plan.types.HandPin), the whole current set: a
+        note not in it has no pin.  The plan then gives a pinned note the other hand
+        only at :meth:`switch_cost` more.  Returns how many pending notes have one."""
+        self.pin_now = now_s
+        n = 0
+        for r in self.pending:
+            hand = (
+                pins.get((r.note.channel, r.note.note, round(r.note.time_s, 9))) if pins else None
+            )
+            if hand != r.pin:
+                r.pin = hand
+                self.forget_plan()
+            n += hand is not None
+        if n:  # the price of a switch grows as the time left shrinks
+            self.forget_plan()
+        return n
+
+    def switch_cost(self, rec: DrumHeld) -> tuple[Hand | None, float]:
+        """The pin of ``rec`` and what giving it to the other hand costs beyond the
+        table: ``shown_hand_penalty`` (drum_costs.toml), and what the speed that hand
+        needs costs (timing.toml [hand_speed], drums.stroke_penalty) when it leaves for
+        the note only now (:attr:`pin_now`), from the piece it struck last, over what the
+        plan charges it from that stroke.  A switch with time to spare costs little; one
+        at the motion's start (rest -> crash in 67 ms) the fastest tier."""
+        hand = rec.pin
+        if hand is None:
+            return None, 0.0
+        timing = self.ctx.config.timing
+        other = drums_mod.LEFT if hand == drums_mod.RIGHT else drums_mod.RIGHT
+        _prev, _pt, t_right, t_left, p_right, p_left = self.state
+        last, piece = (t_left, p_left) if other == drums_mod.LEFT else (t_right, p_right)
+        t, target = rec.note.time_s, rec.drum.piece
+        # what the plan charges that hand from its last stroke in the state (none: free)
+        charged = drums_mod.stroke_penalty(
+            timing, piece, target, math.inf if last is None else t - last
+        )
+        # where it is: over the piece it played last (its ready pose over the snare
+        # when it has played none), leaving now, or when that stroke lands
+        played = next((p for _ft, p in reversed(self.fixed) if p.limb == other), None)
+        where = played.piece if played is not None and played.piece else REST_PIECE
+        leaves = self.pin_now if played is None else max(self.pin_now, played.impact)
+        rushed = drums_mod.stroke_penalty(timing, where, target, t - leaves)
+        return hand, self.ctx.config.costs.shown_hand_penalty + max(0.0, rushed - charged)
 
     def _rebounds(self, groups: list[list[DrumHeld]], decide: bool = True) -> set[int]:
         """The pending hand notes that are rebounds (REBOUND_VELOCITY) of an earlier
@@ -285,7 +358,10 @@ class HandsChain(DrumChain):
             hp = prepared.get(g[0].seq)
             if hp is None:
                 hp = prepared[g[0].seq] = hand_group(
-                    [r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick
+                    [r for r in g if r.seq not in aside],
+                    g[0].note.time_s,
+                    self.foot.can_chick,
+                    self.switch_cost,
                 )
             return hp
 
@@ -298,9 +374,7 @@ class HandsChain(DrumChain):
                 hgs,
                 beam=self.ctx.bounds.beam,
             )
-            steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-            self._remember(hgs, self.state, steps)
-            return steps
+            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
 
         for gi in range(n_groups):
             hp = prepare(groups[gi])
@@ -308,21 +382,11 @@ class HandsChain(DrumChain):
             self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
             self.state = state
 
-    def _remember(
-        self, groups: list[drums_mod.HandGroup], state: drums_mod.HandState, steps: list[HandStep]
-    ) -> None:
-        """Keep solved ``steps`` of ``groups`` (solved from ``state``) for :meth:`provisional`."""
-        if len(self._seen) > 8 * self.ctx.bounds.window_groups:
-            self._seen.clear()
-        for g, step in zip(groups, steps, strict=True):
-            self._seen[g.time] = (g, state, step)
-            state = step[2]
-
     def provisional(self) -> list[PlannedNote]:
         """The hand each pending note would get if nothing more arrived, as planned notes
         not yet fixed (``cost`` 0): the plan the chain holds for the pending groups
-        (what the next commit fixes), else the latest solve's plan of the groups it
-        saw, continued over the groups new notes made (:meth:`_continued`).  Changes nothing: no note's decision is taken,
+        (what the next commit fixes), else the least-cost plan of them, as the commit
+        solves it (:meth:`_solved`).  Changes nothing: no note's decision is taken,
         nothing is fixed or emitted.  Rebounds of earlier strokes and hi-hat notes
         for the left foot are left out (their limb is not the solver's choice)."""
         if not self.pending:
@@ -335,10 +399,15 @@ class HandsChain(DrumChain):
         held = self.plan.held()
         n = min(len(groups), len(held) if held else self.ctx.bounds.window_groups)
         hps = [
-            hand_group([r for r in g if r.seq not in aside], g[0].note.time_s, self.foot.can_chick)
+            hand_group(
+                [r for r in g if r.seq not in aside],
+                g[0].note.time_s,
+                self.foot.can_chick,
+                self.switch_cost,
+            )
             for g in groups[:n]
         ]
-        steps = held if held else self._continued([hp.group for hp in hps])
+        steps = held if held else self._solved([hp.group for hp in hps])
         out: list[PlannedNote] = []
         for hp, (assignment, _costs, _state) in zip(hps, steps, strict=False):
             if len(assignment) != len(hp.group.strokes):
@@ -361,32 +430,27 @@ class HandsChain(DrumChain):
                 out.extend(_unfixed(r, stroke.piece, hand, r) for r in rest)
         return out
 
-    def _continued(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
-        """Steps for ``groups`` (the pending ones, from the chain's state): those of the
-        latest solve while its groups and states are the same, then a solve of the
-        rest from there (usually the one group a new note made).  Cheap, and a plan
-        only to look at: the commit solves its window as always."""
-        self._seen = {t: v for t, v in self._seen.items() if t >= groups[0].time}
-        state = self.state
-        steps: list[HandStep] = []
-        for g in groups:
-            seen = self._seen.get(g.time)
-            if seen is None or seen[0] != g or seen[1] != state:
-                break
-            steps.append(seen[2])
-            state = seen[2][2]
-        rest = groups[len(steps) :]
-        if rest:
-            sol = drums_mod.solve(
-                self.ctx.config.costs,
-                self.ctx.config.timing,
-                state,
-                rest,
-                beam=self.ctx.bounds.beam,
-            )
-            more = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-            self._remember(rest, state, more)
-            steps += more
+    def _solved(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
+        """Steps for ``groups`` (the pending ones, at most a window, from the chain's
+        state): the least-cost plan of them all, as the commit solves it, the last one
+        kept while the groups and state are the same.  Before round 8 the latest solve's
+        steps were continued by a solve of the groups a new note made; that plan could
+        differ from the commit's (a ride shown to the left hand after a hi-hat stroke
+        shown right, where the commit gives the hi-hat to the foot and the ride to the
+        right), and live a hand shown moving now keeps its note (:meth:`pin`), so what is
+        shown is the commit's plan.  Changes nothing the commit uses."""
+        key = (tuple(groups), self.state)
+        if self._shown is not None and self._shown[0] == key:
+            return self._shown[1]
+        sol = drums_mod.solve(
+            self.ctx.config.costs,
+            self.ctx.config.timing,
+            self.state,
+            groups,
+            beam=self.ctx.bounds.beam,
+        )
+        steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+        self._shown = (key, steps)
         return steps
 
     def _fix_group(

@@ -17,7 +17,7 @@ from virja.events import NoteOn
 from virja.plan import drums as drums_mod
 from virja.plan.chain import Chain, Held
 from virja.plan.config import DrumNote
-from virja.vocab import DrumStroke, as_limb, as_piece
+from virja.vocab import DrumStroke, Hand, as_limb, as_piece
 
 HAND_WINDOW_S = 0.030
 # A note this soft on the piece a limb has just struck, sooner than the limb could
@@ -47,6 +47,7 @@ class DrumHeld(Held):
     drum: DrumNote
     rebound: bool | None = None  # hands: a rebound of an earlier stroke on its piece
     to_foot: bool | None = None  # hands: a hi-hat note given to the left foot
+    pin: Hand | None = None  # hands, live: the hand drawn moving for it (plan.types.HandPin)
 
 
 class DrumChain(Chain[DrumHeld]):

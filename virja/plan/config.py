@@ -148,6 +148,9 @@ class DrumCosts:
     motions: tuple[str, ...]
     table: tuple[tuple[float, ...], ...]
     drop_penalty: float
+    # live only: a note given the other hand than the one drawn moving for it
+    # (``Stroke.pin``, drum_costs.toml)
+    shown_hand_penalty: float = 4.0
     _rows: dict[tuple[str, str], int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -337,6 +340,7 @@ class CostsFile(Schema):
     motions: list[str]
     rows: dict[str, dict[str, float]]
     drop_penalty: float = 1000.0
+    shown_hand_penalty: float = 4.0
 
 
 class HandMoveTable(Schema):
@@ -464,7 +468,7 @@ def parse_costs(data: dict[str, Any], *, where: str = "drum_costs.toml") -> Drum
         if set(row) != set(motions):
             raise ConfigError(f"{where}: row {row_name!r} must give all {len(motions)} columns")
         table.append(tuple(row[c] for c in motions))
-    return DrumCosts(motions, tuple(table), f.drop_penalty)
+    return DrumCosts(motions, tuple(table), f.drop_penalty, f.shown_hand_penalty)
 
 
 def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:

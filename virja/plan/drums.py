@@ -18,7 +18,9 @@ that leaves the arms crossed while the other hand struck a moment before pays fo
 crossing (timing.toml ``[hand_cross]``, :func:`cross_penalty`).  A stroke that no hand
 can make in time is dropped at a penalty (``drop_penalty`` + 9 - priority), so dropping
 happens only when nothing else is feasible.  Ties go to the right hand (the time-keeping
-hand keeps the time).
+hand keeps the time).  Live, a stroke whose provisional hand is already drawn moving for
+it (``Stroke.pin``) costs more with the other hand (``Stroke.switch``,
+:func:`switch_penalty`), which can leave for it only now.
 
 Feet are unambiguous: right foot kick, left foot hi-hat pedal.
 """
@@ -48,6 +50,10 @@ class Stroke:
     priority: int
     dt: float = 0.0  # its note's time after the group's time (within the grouping window)
     foot: bool = False  # a hi-hat stroke the left foot can take (a chick on the pedal)
+    # live only: the hand drawn moving for it already (a pin, plan.types.HandPin), and
+    # what giving it to the other hand costs more (:func:`switch_penalty`)
+    pin: Hand | None = None
+    switch: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -108,6 +114,16 @@ def unplayed_penalty(
         ):
             return timing.stretch_penalty
     return drop_penalty(costs, strokes[i])
+
+
+def switch_penalty(stroke: Stroke, hand: Hand | None) -> float:
+    """What giving ``stroke`` to ``hand`` costs beyond the table because another hand
+    was drawn moving for it (``Stroke.pin``, live only): ``Stroke.switch`` for the other
+    hand (virja.plan.chain_hands prices it: the other hand leaves only now), nothing
+    for the pinned one or a drop (which pays its own)."""
+    if stroke.pin is None or hand is None or hand == stroke.pin:
+        return 0.0
+    return stroke.switch
 
 
 def _steps(timing: Timing, prev: str | None, piece: str) -> tuple[tuple[float, float], ...]:
@@ -195,6 +211,8 @@ def transition(
     for i, hand in enumerate(assign):
         if hand is None:
             total += unplayed_penalty(costs, timing, group.strokes, assign, i)
+        elif group.strokes[i].pin is not None:
+            total += switch_penalty(group.strokes[i], hand)
     if order:
         prev, prev_t = row, t
     return total, (prev, prev_t, t_right, t_left, p_right, p_left), tuple(per)
@@ -225,7 +243,8 @@ class _Option:
     """One assignment of a group, precompiled: what :func:`transition` computes each time.
 
     ``played`` lists the played strokes left hand first as ``(is_right, motion, piece,
-    dt, stroke index)``; ``penalty`` is the sum of the drop penalties.
+    dt, stroke index)``; ``penalty`` is the sum of the drop penalties (and, live, of
+    the :func:`switch_penalty` of a stroke given the other hand than its pin).
     """
 
     assign: Assignment
@@ -392,6 +411,8 @@ def _compile(costs: DrumCosts, timing: Timing, strokes: tuple[Stroke, ...]) -> _
             if hand is None:
                 penalty += unplayed_penalty(costs, timing, strokes, assign, i)
             else:
+                if stroke.pin is not None:  # live: another hand drawn moving for it
+                    penalty += switch_penalty(stroke, hand)
                 played.append(
                     (hand == RIGHT, costs.index(stroke.piece, hand), stroke.piece, stroke.dt, i)
                 )

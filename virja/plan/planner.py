@@ -17,7 +17,7 @@ What every chain shares is in :mod:`virja.plan.chain`.  See docs/scheduler.md.
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from virja.events import Beat, NoteOn
 from virja.plan.bounds import DEFAULT_BOUNDS, PlanBounds
@@ -34,7 +34,7 @@ from virja.plan.chain_hands import (
 )
 from virja.plan.chain_kit import HAND_WINDOW_S, REBOUND_VELOCITY
 from virja.plan.config import PlanConfig, default_config
-from virja.plan.types import PlannedNote, PlanReport
+from virja.plan.types import HandPin, PlannedNote, PlanReport
 from virja.tempo import DEFAULT_SECONDS_PER_BEAT, Tempo
 from virja.vocab import Performer
 
@@ -157,6 +157,21 @@ class OnlinePlanner:
             chain.take(chain.held(self._seq, note, now_s, dn))
         else:
             raise ValueError(f"unknown performer {performer!r}")
+
+    def pin_hands(self, pins: Iterable[HandPin], *, now_s: float) -> int:
+        """Live: the drum notes whose provisional hand is drawn moving for them at
+        ``now_s`` (the animator says which, ``BandAnimator.shown_moving``; the
+        performance passes the whole current set before each commit).  The plan then
+        gives such a note the other hand only at a price: what that hand's speed costs
+        when it leaves only now, plus ``shown_hand_penalty``
+        (:meth:`virja.plan.chain_hands.HandsChain.switch_cost`): with time to spare the
+        plan may still switch, at the motion's start it keeps the hand shown unless it
+        cannot play the note in time or that would drop a note.  Returns how many pending
+        notes have a pin.  Whole-input planning (``run_schedule``) draws nothing and pins
+        none: its plans are unchanged (docs/motion.md, round 8)."""
+        return self._hands.pin(
+            {(p.channel, p.note, round(p.time_s, 9)): p.hand for p in pins}, now_s
+        )
 
     # -- outputs --------------------------------------------------------------
 

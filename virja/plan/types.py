@@ -13,13 +13,14 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from virja.events import NoteOn
-from virja.vocab import LIMBS, BassString, Limb, MotionKey, Performer, Piece
+from virja.vocab import LIMBS, BassString, Hand, Limb, MotionKey, Performer, Piece
 
 __all__ = [
     "JSON_KEYS",
     "LIMBS",
     "DropReason",
     "DroppedNote",
+    "HandPin",
     "Limb",
     "MovedNote",
     "PlanReport",
@@ -197,6 +198,21 @@ DROP_REASON_TEXT: dict[str, str] = {
     "too_dense": "more notes around its time than anyone plays",
     "planner_full": "the plan already held the most notes it may wait on",
 }
+
+
+@dataclass(frozen=True, slots=True)
+class HandPin:
+    """A drum note whose provisional hand has been drawn moving for it (live: the
+    hand's motion toward it began at or before a frame already shown, since
+    ``since_s``): the planner keeps that hand for it unless it cannot play the note
+    in time (``OnlinePlanner.pin_hands``).  The note is named as the planner got it:
+    channel (0-15), note number and time (session seconds)."""
+
+    channel: int
+    note: int
+    time_s: float
+    hand: Hand
+    since_s: float
 
 
 @dataclass(frozen=True)

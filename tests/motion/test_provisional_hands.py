@@ -197,26 +197,28 @@ def test_with_nothing_drawn_the_provisional_hands_leave_no_trace(library: Motion
 
 def _live(library: MotionLibrary, pins: bool) -> tuple[BandAnimator, dict[int, PlannedNote]]:
     """At 300 bpm: a crash known 0.2 s ahead (the right hand, from rest, is shown moving
-    toward it), then a ride 60 ms after it known only 6 ms before the crash's motion
+    toward it), then a high tom 80 ms after it known only 6 ms before the crash's motion
     starts; played as the live window draws it (30 fps), hands drawn moving pinned in
     the plan or not."""
     a = _animator(library)
     perf = Performance(router=Router(), planner=OnlinePlanner(), animator=a)
     perf.pin_shown = pins
     beats = [Reveal(0.0, Beat(0.2 * k, k // 4, k % 4 + 1, 4, 0, 200_000)) for k in range(12)]
-    notes = [Reveal(1.3, NoteOn(1.5, 9, 49, 100)), Reveal(1.39, NoteOn(1.56, 9, 51, 90))]
+    notes = [Reveal(1.3, NoteOn(1.5, 9, 49, 100)), Reveal(1.39, NoteOn(1.58, 9, 48, 90))]
     planned = run_as_live(perf, beats + notes, 30.0, 0.0)
     return a, {p.note: p for p in planned}
 
 
 def test_a_hand_drawn_moving_keeps_its_note_at_the_motions_start(library: MotionLibrary) -> None:
     """The unit case of round 7 through the planner: the right hand has been drawn on
-    its way from rest to the crash when a late ride makes the left hand the cheaper
-    crash hand by the table; on main the plan gave the crash to the left 6 ms before its
-    motion started (110 ms before it sounds), the right turned back.  Now the plan
-    keeps the crash on the right (the other hand would leave only then: the speed tier
-    it needs costs more than the crossing), the late ride goes to the free left hand,
-    and no wrist passes 8 m/s."""
+    its way from rest to the crash when a late high tom makes the left hand the cheaper
+    crash hand by the table; on main 8b7d05b the plan gave the crash to the left 6 ms
+    before its motion started (110 ms before it sounds), the right turned back.  Now the
+    plan keeps the crash on the right (the other hand would leave only then: the speed
+    tier it needs costs more than the table's difference), the right goes on to the tom
+    80 ms later, and no wrist passes 8 m/s.  (Round 7's case had a late ride instead of
+    the tom: there, since round 8's crossed-arms price, the left taking the crash and the
+    right the ride is the better plan, arms open, and the plan gives it.)"""
     a, planned = _live(library, pins=True)
     assert planned[49].limb == "right_hand"
     assert a.provisional_counts["fixed_other"] == 0

@@ -40,6 +40,7 @@ import numpy as np
 
 from virja import quat
 from virja.geometry import GEOMETRY, Geometry
+from virja.motion.ik import frames
 from virja.motion.skeleton import SKELETON
 from virja.vocab import HANDS
 
@@ -307,10 +308,7 @@ class DrummerBody:
 
 def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frames (..., 3, 3), columns [d, h orthogonalised, d x h]."""
-    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
-    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
-    return np.stack([d, h, np.cross(d, h)], axis=-1)
+    return frames(d, h)
 
 
 def _resolve_arm(

@@ -187,12 +187,22 @@ def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> F:
     return np.concatenate([np.cos(half), np.sin(half) * ax / n], axis=-1)
 
 
+def _rows(a: F, shape: tuple[int, ...], k: int) -> list[list[float]]:
+    """``a`` broadcast to ``shape`` as Python rows of ``k`` floats."""
+    if a.shape != shape:
+        n = math.prod(shape) // k
+        if a.size == k:  # one row for all
+            return a.reshape(1, k).tolist() * n
+        a = np.broadcast_to(a, shape)
+    return a.reshape(-1, k).tolist()  # type: ignore[no-any-return]
+
+
 def _from_axis_angle_few(ax: F, ang: F) -> F:
     """:func:`from_axis_angle` of a few in Python floats (the same operations)."""
     shape = np.broadcast_shapes(ax.shape[:-1], ang.shape)
-    axes = np.broadcast_to(ax, shape + (3,)).reshape(-1, 3).tolist()
+    axes, angles = _rows(ax, shape + (3,), 3), _rows(ang, shape, 1)
     out = []
-    for (x, y, z), a in zip(axes, np.broadcast_to(ang, shape).reshape(-1).tolist(), strict=True):
+    for (x, y, z), (a,) in zip(axes, angles, strict=True):
         n = math.sqrt(x * x + y * y + z * z)
         if n == 0:
             raise ValueError("rotation axis must not be the zero vector")
@@ -357,9 +367,8 @@ def slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F:
 def _slerp_few(qa: F, qb: F, tt: F) -> F:
     """:func:`slerp` of a few in Python floats (the same operations; numpy's arccos)."""
     shape = np.broadcast_shapes(qa.shape, qb.shape, tt.shape)
-    ra = np.broadcast_to(qa, shape).reshape(-1, 4).tolist()
-    rb = np.broadcast_to(qb, shape).reshape(-1, 4).tolist()
-    ts = np.broadcast_to(tt, shape[:-1] + (1,)).reshape(-1).tolist()
+    ra, rb = _rows(qa, shape, 4), _rows(qb, shape, 4)
+    ts = [t for (t,) in _rows(tt, shape[:-1] + (1,), 1)]
     dots = [
         a0 * b0 + a1 * b1 + a2 * b2 + a3 * b3
         for (a0, a1, a2, a3), (b0, b1, b2, b3) in zip(ra, rb, strict=True)

@@ -120,10 +120,32 @@ def rotate(q: ArrayLike, v: ArrayLike) -> F:
     """Rotate vectors ``v`` (..., 3) by unit quaternions ``q`` (..., 4); broadcasts."""
     qa = asquat(q)
     va = np.asarray(v, dtype=np.float64)
+    if qa.size <= 4 * _FEW and va.size <= 3 * _FEW:
+        return _rotate_few(qa, va)
     w = qa[..., :1]
     u = qa[..., 1:]
     t = 2.0 * cross(u, va)
     return va + w * t + cross(u, t)
+
+
+def _rotate_few(qa: F, va: F) -> F:
+    """:func:`rotate` of a few in Python floats (the same operations)."""
+    shape = np.broadcast_shapes(qa.shape[:-1] + (3,), va.shape)
+    out = []
+    for (w, ux, uy, uz), (vx, vy, vz) in zip(
+        _rows(qa, shape[:-1] + (4,), 4), _rows(va, shape, 3), strict=True
+    ):
+        tx = 2.0 * (uy * vz - uz * vy)
+        ty = 2.0 * (uz * vx - ux * vz)
+        tz = 2.0 * (ux * vy - uy * vx)
+        out.append(
+            [
+                vx + w * tx + (uy * tz - uz * ty),
+                vy + w * ty + (uz * tx - ux * tz),
+                vz + w * tz + (ux * ty - uy * tx),
+            ]
+        )
+    return np.array(out).reshape(shape)
 
 
 def rotate_one(q: F, v: F) -> F:

@@ -97,7 +97,7 @@ def multiply(a: ArrayLike, b: ArrayLike) -> F:
 
 def _multiply_few(qa: F, qb: F) -> F:
     """:func:`multiply` of a few quaternions in Python floats (the same operations)."""
-    shape = qa.shape if qa.shape == qb.shape else np.broadcast_shapes(qa.shape, qb.shape)
+    shape = _broadcast(qa.shape, qb.shape)
     ra, rb = qa.reshape(-1, 4).tolist(), qb.reshape(-1, 4).tolist()
     n = max(len(ra), len(rb))
     if n != len(ra) or n != len(rb):  # broadcast: repeat to the output's rows
@@ -130,7 +130,7 @@ def rotate(q: ArrayLike, v: ArrayLike) -> F:
 
 def _rotate_few(qa: F, va: F) -> F:
     """:func:`rotate` of a few in Python floats (the same operations)."""
-    shape = np.broadcast_shapes(qa.shape[:-1] + (3,), va.shape)
+    shape = _broadcast(qa.shape[:-1] + (3,), va.shape)
     out = []
     for (w, ux, uy, uz), (vx, vy, vz) in zip(
         _rows(qa, shape[:-1] + (4,), 4), _rows(va, shape, 3), strict=True
@@ -209,6 +209,19 @@ def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> F:
     return np.concatenate([np.cos(half), np.sin(half) * ax / n], axis=-1)
 
 
+def _broadcast(*shapes: tuple[int, ...]) -> tuple[int, ...]:
+    """``np.broadcast_shapes`` of a few shapes, without its cost when they are equal or
+    differ only by leading ones (a single quaternion against a row of one)."""
+    first = shapes[0]
+    if all(s == first for s in shapes[1:]):
+        return first
+    n = max(len(s) for s in shapes)
+    padded = [(1,) * (n - len(s)) + s for s in shapes]
+    if all(p == padded[0] for p in padded[1:]):
+        return padded[0]
+    return tuple(np.broadcast_shapes(*shapes))
+
+
 def _rows(a: F, shape: tuple[int, ...], k: int) -> list[list[float]]:
     """``a`` broadcast to ``shape`` as Python rows of ``k`` floats."""
     if a.shape != shape:
@@ -221,7 +234,7 @@ def _rows(a: F, shape: tuple[int, ...], k: int) -> list[list[float]]:
 
 def _from_axis_angle_few(ax: F, ang: F) -> F:
     """:func:`from_axis_angle` of a few in Python floats (the same operations)."""
-    shape = np.broadcast_shapes(ax.shape[:-1], ang.shape)
+    shape = _broadcast(ax.shape[:-1], ang.shape)
     axes, angles = _rows(ax, shape + (3,), 3), _rows(ang, shape, 1)
     out = []
     for (x, y, z), (a,) in zip(axes, angles, strict=True):
@@ -388,7 +401,7 @@ def slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F:
 
 def _slerp_few(qa: F, qb: F, tt: F) -> F:
     """:func:`slerp` of a few in Python floats (the same operations; numpy's arccos)."""
-    shape = np.broadcast_shapes(qa.shape, qb.shape, tt.shape)
+    shape = _broadcast(qa.shape, qb.shape, tt.shape)
     ra, rb = _rows(qa, shape, 4), _rows(qb, shape, 4)
     ts = [t for (t,) in _rows(tt, shape[:-1] + (1,), 1)]
     dots = [

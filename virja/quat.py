@@ -229,7 +229,7 @@ def _rows(a: F, shape: tuple[int, ...], k: int) -> list[list[float]]:
         if a.size == k:  # one row for all
             return a.reshape(1, k).tolist() * n
         a = np.broadcast_to(a, shape)
-    return a.reshape(-1, k).tolist()  # type: ignore[no-any-return]
+    return a.reshape(-1, k).tolist()
 
 
 def _from_axis_angle_few(ax: F, ang: F) -> F:
@@ -292,8 +292,8 @@ def from_matrix(m: ArrayLike) -> F:
     if r.shape[-2:] != (3, 3):
         raise ValueError(f"rotation matrices need shape (..., 3, 3), got {r.shape}")
     if r.size <= 9 * _FEW:
-        rows = [_from_matrix_one(m) for m in r.reshape(-1, 9).tolist()]
-        return np.array(rows).reshape(r.shape[:-2] + (4,))
+        found = [_from_matrix_one(m) for m in r.reshape(-1, 9).tolist()]
+        return np.array(found).reshape(r.shape[:-2] + (4,))
     # Shepperd's method, vectorised: pick the largest of 4 candidates per matrix.
     # (written into one array: a stack of stacks cost more than the arithmetic)
     tr = r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2]

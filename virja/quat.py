@@ -181,7 +181,7 @@ def cross(a: F, b: F) -> F:
                 a.reshape(-1, 3).tolist(), b.reshape(-1, 3).tolist(), strict=True
             )
         ]
-        return np.array(rows).reshape(a.shape)
+        return np.array(rows, dtype=np.float64).reshape(a.shape)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.float64)

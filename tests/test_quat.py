@@ -159,3 +159,58 @@ def test_from_two_vectors_including_opposite() -> None:
 def test_bad_shape_raises_value_error() -> None:
     with pytest.raises(ValueError, match="last axis of 4"):
         Q.multiply(np.zeros(3), np.zeros(4))
+
+
+# A few quaternions (up to quat._FEW rows) are worked out in Python floats, more as
+# arrays: the two ways must agree, row by row, for every function with such a path.
+_MANY = 3 * Q._FEW  # enough rows for the array path
+
+
+def _both_ways(fn, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # type: ignore[no-untyped-def]
+    """``fn`` over all rows at once (the arrays) and one row at a time (Python floats)."""
+    assert all(len(a) == _MANY for a in args)
+    many = fn(*args)
+    few = np.stack([fn(*(a[i : i + 1] for a in args))[0] for i in range(_MANY)])
+    return many, few
+
+
+def test_few_rows_in_python_floats_equal_the_arrays() -> None:
+    a, b = _rand(_MANY), _rand(_MANY)
+    b[:5] = -a[:5] + 1e-9  # near-antipodal: slerp flips the sign
+    b[5:9] = a[5:9]  # identical: slerp's linear fallback
+    t = RNG.uniform(-0.2, 1.2, size=_MANY)
+    v = RNG.normal(size=(_MANY, 3))
+    angle = RNG.uniform(-4.0, 4.0, size=_MANY)
+    # matrices whose largest of trace, xx, yy, zz picks each of Shepperd's four rows
+    turns = np.concatenate(
+        [Q.identity((4,)), Q.from_axis_angle(np.eye(3), np.full(3, 3.0)), _rand(_MANY - 7)]
+    )
+    raw = RNG.normal(size=(_MANY, 4))
+    raw[0] = 0.0  # a zero quaternion normalises to the identity
+    for name, (many, few) in {
+        "multiply": _both_ways(Q.multiply, a, b),
+        "normalize": _both_ways(Q.normalize, raw),
+        "rotate": _both_ways(Q.rotate, a, v),
+        "cross": _both_ways(Q.cross, v, v[::-1].copy()),
+        "from_matrix": _both_ways(Q.from_matrix, Q.to_matrix(turns)),
+        "from_axis_angle": _both_ways(Q.from_axis_angle, v, angle),
+        "slerp": _both_ways(Q.slerp, a, b, t),
+    }.items():
+        assert many.shape == few.shape, name
+        # the same IEEE operations in the same order; sin and cos from numpy and math
+        # could differ by an ulp on some platforms
+        np.testing.assert_allclose(few, many, rtol=0, atol=1e-15, err_msg=name)
+
+
+def test_few_rows_broadcast_as_the_arrays_do() -> None:
+    a, v = _rand(3), RNG.normal(size=(3, 3))
+    assert Q.multiply(a[0], a[:, None]).shape == (3, 1, 4)
+    np.testing.assert_array_equal(Q.multiply(a[0], a), np.stack([Q.multiply(a[0], q) for q in a]))
+    np.testing.assert_array_equal(Q.rotate(a[0], v), np.stack([Q.rotate(a[0], x) for x in v]))
+    np.testing.assert_array_equal(
+        Q.from_axis_angle([0.0, 1.0, 0.0], np.array([0.1, 0.2])),
+        Q.from_axis_angle(np.array([[0.0, 1.0, 0.0]] * 2), np.array([0.1, 0.2])),
+    )
+    assert Q.slerp(a[0], a[1], np.array([0.0, 0.5, 1.0])).shape == (3, 4)
+    with pytest.raises(ValueError, match="zero vector"):
+        Q.from_axis_angle(np.zeros(3), 1.0)

@@ -101,3 +101,41 @@ def test_sticks_of_many_frames_equal_one_at_a_time() -> None:
     many = sticks(wpos, wrot)
     for k in range(len(times)):
         assert np.array_equal(many[k], sticks(wpos[k], wrot[k]))
+
+
+def test_one_frame_at_a_time_equals_the_batched_pose_through_live_news() -> None:
+    """As the live window and the jam pose: news arrives between frames (notes known,
+    provisional hands shown, revised and fixed), each frame is posed alone with
+    ``pose(t)`` (which marks it drawn); the batched pose of the same time, taken just
+    before (many frames at once: the arrays, not the few-row paths), equals it."""
+    src = load_performance_input(DEMO_MID, RoutingConfig())
+    animator = BandAnimator()
+    perf = Performance(
+        router=Router.for_session(src.midi, RoutingConfig()),
+        planner=OnlinePlanner(tempo=src.tempo),
+        animator=animator,
+    )
+    schedule = sorted(src.schedule, key=lambda r: r.at_s)
+    t0 = schedule[0].at_s
+    k, fed, drawn = 0, 0, 0
+    for t in t0 + np.arange(0.0, 6.0, 1 / 30):  # a frame every 33 ms, 6 s of the demo
+        while k < len(schedule) and schedule[k].at_s <= t:
+            perf.advance(schedule[k].at_s)
+            perf.feed(schedule[k].event, now_s=schedule[k].at_s)
+            k, fed = k + 1, fed + 1
+        perf.advance(float(t))
+        ahead = float(t) + np.arange(40) / 60  # this frame and the next ones, batched
+        batch = animator.pose_batch(ahead).pose(0)
+        one = perf.pose(float(t))
+        drawn += 1
+        assert animator.drawn_until == float(t)
+        for a, b in ((one.drums, batch.drums), (one.bass, batch.bass)):
+            np.testing.assert_allclose(a.positions, b.positions, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(a.rotations, b.rotations, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(one.sticks, batch.sticks, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(one.bass_fingers, batch.bass_fingers, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(one.bass_transform, batch.bass_transform, rtol=0, atol=1e-9)
+        assert one.hihat_open == pytest.approx(batch.hihat_open, abs=1e-9)
+        assert one.string_stops == batch.string_stops
+    assert fed > 20 and drawn == 180
+    assert animator.provisional_counts["shown"] > 0  # hands shown before their plan

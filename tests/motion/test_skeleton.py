@@ -96,3 +96,24 @@ def test_clip_joint_angles_stay_within_limits() -> None:
     for clip in default_library().clips():
         ang = np.degrees(quat.angle(clip.rotations))
         assert np.all(ang.max(axis=0) <= SK.limits_deg + 1e-6), clip.name
+
+
+def test_frames_of_a_few_rows_equal_the_arrays_and_are_orthonormal() -> None:
+    from virja.motion import ik
+
+    rng = np.random.default_rng(3)
+    n = 3 * ik._FEW_FRAMES  # the arrays; one row at a time takes Python floats
+    d, h = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    h[0] = 2.0 * d[0]  # parallel: h is nothing after it is made perpendicular
+    for floor in (1e-12, 0.0):
+        many = ik.frames(d, h, floor)
+        few = np.stack([ik.frames(d[i : i + 1], h[i : i + 1], floor)[0] for i in range(n)])
+        np.testing.assert_allclose(few, many, rtol=0, atol=1e-15)
+        ok = many[1:]
+        np.testing.assert_allclose(
+            ok @ np.swapaxes(ok, -1, -2), np.broadcast_to(np.eye(3), ok.shape), atol=1e-12
+        )
+        np.testing.assert_allclose(np.linalg.det(ok), 1.0, atol=1e-12)
+        assert np.allclose(many[1:, :, 0] * np.linalg.norm(d[1:], axis=-1, keepdims=True), d[1:])
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero direction: nan, as arrays
+        assert np.isnan(ik.frames(np.zeros((1, 3)), np.ones((1, 3)))).all()

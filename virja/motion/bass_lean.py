@@ -42,7 +42,8 @@ def lean(chest: np.ndarray, rest_chest: np.ndarray, bass: UprightBass, follow: f
     r2 = float(r @ r)
     d = follow * (np.asarray(chest, dtype=np.float64) - np.asarray(rest_chest, dtype=np.float64))
     d = d - (d @ r)[..., None] * r / r2  # along the bass it cannot follow (the endpin holds)
-    w = np.cross(r, d) / r2  # rotation vector: the contact point moves by w x r = d
+    # rotation vector: the contact point moves by w x r = d
+    w = quat.cross(np.broadcast_to(r, d.shape), d) / r2
     angle = np.linalg.norm(w, axis=-1)
     axis = np.where(angle[..., None] > 1e-12, w, np.array([1.0, 0.0, 0.0]))
     return quat.from_axis_angle(axis / np.linalg.norm(axis, axis=-1, keepdims=True), angle)

@@ -40,6 +40,7 @@ from virja import quat
 from virja.fingerboard import Fingerboard, fingerboard
 from virja.geometry import Geometry
 from virja.motion import bass_lean
+from virja.motion.ik import frames
 from virja.motion.skeleton import SKELETON
 from virja.vocab import BASS_STRINGS, BassPluck, MotionKey
 
@@ -165,10 +166,7 @@ def fretting_side(
 
 def _frames(direction: np.ndarray, hinge: np.ndarray) -> np.ndarray:
     """(k, 3, 3) frames with columns (direction, hinge made perpendicular, their cross)."""
-    d = direction / np.linalg.norm(direction, axis=-1, keepdims=True)
-    h = hinge - np.sum(hinge * d, axis=-1, keepdims=True) * d
-    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
-    return np.stack([d, h, np.cross(d, h)], axis=-1)
+    return frames(direction, hinge, floor=0.0)
 
 
 _REST_T = _frames(_ARM_REST_DIR[None], _ARM_REST_HINGE[None])[0].T
@@ -194,9 +192,9 @@ def _two_bone(
     end = roots + d[:, None] * u
     u1 = (elbow - roots) / np.linalg.norm(elbow - roots, axis=-1, keepdims=True)
     u2 = (end - elbow) / np.linalg.norm(end - elbow, axis=-1, keepdims=True)
-    hinge = np.cross(u1, u2)
+    hinge = quat.cross(u1, u2)
     straight = np.linalg.norm(hinge, axis=-1) < 1e-9  # a straight arm bends toward its pole
-    hinge[straight] = np.cross(u1[straight], v[straight])
+    hinge[straight] = quat.cross(u1[straight], v[straight])
     upper = quat.from_matrix(_frames(u1, hinge) @ _REST_T)
     lower = quat.from_matrix(_frames(u2, hinge) @ _REST_T)
     return upper, lower
@@ -666,7 +664,7 @@ class Bassist:
         clav, shoulder = pos[:, _SHOULDERS[0]], pos[:, _ARMS[0]]
         excess = np.linalg.norm(wrist - shoulder, axis=-1) - s.shoulder_slack_m
         bone = shoulder - clav
-        axis = np.cross(bone, wrist - clav)
+        axis = quat.cross(bone, wrist - clav)
         n = np.linalg.norm(axis, axis=-1)
         rows = np.nonzero((excess > 0.0) & (n >= 1e-12))[0]
         if rows.size == 0:

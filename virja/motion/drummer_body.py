@@ -40,6 +40,7 @@ import numpy as np
 
 from virja import quat
 from virja.geometry import GEOMETRY, Geometry
+from virja.motion.ik import frames
 from virja.motion.skeleton import SKELETON
 from virja.vocab import HANDS
 
@@ -287,13 +288,13 @@ class DrummerBody:
         out[:, _NECK] = quat.multiply(quat.from_axis_angle(_UP, yaw * s.head_share), out[:, _NECK])
         press = awake * self.feather(t, beat_times)
         out[:, _RFOOT] = quat.multiply(out[:, _RFOOT], quat.from_axis_angle(_SIDE, press))
-        # forward kinematics with world rotations as matrices; only the arms' converted
-        p0, m0 = _SK.fk_matrices(local, root)
-        p1, m1 = _SK.fk_matrices(out, root)
-        r0 = np.zeros(m0.shape[:-2] + (4,))
-        r1 = np.zeros_like(r0)
-        r0[:, _ARM_JOINTS] = quat.from_matrix(m0[:, _ARM_JOINTS])
-        r1[:, _ARM_JOINTS] = quat.from_matrix(m1[:, _ARM_JOINTS])
+        # forward kinematics with world rotations as matrices, before and after the body
+        # layer in one pass; only the arms' converted
+        m = len(t)
+        p, mat = _SK.fk_matrices(np.concatenate([np.asarray(local, dtype=np.float64), out]), root)
+        r = np.zeros(mat.shape[:-2] + (4,))
+        r[:, _ARM_JOINTS] = quat.from_matrix(mat[:, _ARM_JOINTS])
+        p0, r0, p1, r1 = p[:m], r[:m], p[m:], r[m:]
         for hand in HANDS:
             c = self.engagement(hand, t)
             if not np.any(c > 0):
@@ -307,10 +308,10 @@ class DrummerBody:
 
 def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frames (..., 3, 3), columns [d, h orthogonalised, d x h]."""
-    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
-    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
-    return np.stack([d, h, np.cross(d, h)], axis=-1)
+    return frames(d, h)
+
+
+_BONE_M = [float(np.linalg.norm(o)) for o in _SK.offsets]  # each joint's bone length (m)
 
 
 def _resolve_arm(
@@ -324,8 +325,7 @@ def _resolve_arm(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Local rotations of (arm, forearm, hand) putting the wrist and hand as in the
     authored pose (``p0``, ``r0``) from the moved ``shoulder`` (m, 3)."""
-    l1 = float(np.linalg.norm(_SK.offsets[fore]))
-    l2 = float(np.linalg.norm(_SK.offsets[wrist]))
+    l1, l2 = _BONE_M[fore], _BONE_M[wrist]
     s0, e0, w = p0[:, arm], p0[:, fore], p0[:, wrist]
     to = w - shoulder
     dist = np.linalg.norm(to, axis=-1)

@@ -54,6 +54,7 @@ import numpy as np
 from virja.geometry import GEOMETRY, DrumKit
 from virja.motion import drummer_clear, quat
 from virja.motion.clip import Clip
+from virja.motion.ik import frames
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
 from virja.vocab import CYMBAL_PIECES
 
@@ -944,7 +945,7 @@ class DrummerHands:
         # the stick turns up about the wrist, the wrist rises a share of the lift
         s = self.settings
         d = quat.rotate(rot, STICK_AXIS_LOCAL)
-        axis = np.cross(d, _UP)
+        axis = quat.cross(d, _UP)
         norm = np.linalg.norm(axis, axis=-1, keepdims=True)
         axis = axis / np.maximum(norm, 1e-9)
         lever = STICK_TIP_M + float(np.linalg.norm(off))
@@ -1016,10 +1017,7 @@ def _cut_detour(
 
 def _frames(d: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frames (..., 3, 3), columns [d, h orthogonalised, d x h]."""
-    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
-    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-12)
-    return np.stack([d, h, np.cross(d, h)], axis=-1)
+    return frames(d, h)
 
 
 __all__ = ["DrummerHands", "HandSettings", "HANDS"]

@@ -8,6 +8,7 @@ plane is fixed by a pole point.  Rotations are w x y z quaternions, vectors
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,47 @@ from virja import quat
 
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
+
+
+# up to this many rows :func:`frames` works in Python floats (one frame at a time, the
+# live window's pose: docs/performance.md, "One frame at a time, eighth round")
+_FEW_FRAMES = 16
+
+
+def frames(d: np.ndarray, h: np.ndarray, floor: float = 1e-12) -> np.ndarray:
+    """Right-handed orthonormal frames (..., 3, 3) of rows ``d``, ``h`` (..., 3): columns
+    [d, h made perpendicular to d, d x h]; ``h``'s length after that is taken as at least
+    ``floor`` (0: as it is).  A few rows are worked out in Python floats with the same
+    operations in the same order as the arrays, so the frames are equal either way."""
+    if d.shape == h.shape and d.size <= 3 * _FEW_FRAMES:
+        try:
+            rows = [
+                _frame_row(a, b, floor)
+                for a, b in zip(d.reshape(-1, 3).tolist(), h.reshape(-1, 3).tolist(), strict=True)
+            ]
+        except ZeroDivisionError:  # a zero direction: the arrays' nan, as before
+            pass
+        else:
+            return np.array(rows).reshape(d.shape + (3,))
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    h = h - np.sum(h * d, axis=-1, keepdims=True) * d
+    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), floor)
+    return np.stack([d, h, quat.cross(d, h)], axis=-1)
+
+
+def _frame_row(d: list[float], h: list[float], floor: float) -> list[float]:
+    """One frame of :func:`frames`, its 9 entries row by row."""
+    dx, dy, dz = d
+    n = math.sqrt(dx * dx + dy * dy + dz * dz)
+    dx, dy, dz = dx / n, dy / n, dz / n
+    hx, hy, hz = h
+    k = hx * dx + hy * dy + hz * dz
+    hx, hy, hz = hx - k * dx, hy - k * dy, hz - k * dz
+    m = math.sqrt(hx * hx + hy * hy + hz * hz)
+    m = floor if m < floor else m
+    hx, hy, hz = hx / m, hy / m, hz / m
+    cx, cy, cz = dy * hz - dz * hy, dz * hx - dx * hz, dx * hy - dy * hx
+    return [dx, hx, cx, dy, hy, cy, dz, hz, cz]
 
 
 def _frame(direction: np.ndarray, hinge: np.ndarray) -> np.ndarray:

@@ -12,6 +12,7 @@ tree (all joints of one depth in one numpy call):
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -82,6 +83,11 @@ class Skeleton:
     def _offset_cols(self) -> np.ndarray:
         return self.offsets[:, :, None]
 
+    @functools.cached_property
+    def _level_offsets(self) -> tuple[np.ndarray, ...]:
+        """Each level's joint offsets as columns (k, 3, 1), made once (FK runs per frame)."""
+        return tuple(self._offset_cols[idx] for idx, _par in self._levels)
+
     @property
     def n_joints(self) -> int:
         return len(self.names)
@@ -119,10 +125,10 @@ class Skeleton:
         wpos = np.empty(rl.shape[:-2] + (3,), dtype=np.float64)
         rw[..., 0, :, :] = rl[..., 0, :, :]
         wpos[..., 0, :] = root_position
-        for idx, par in self._levels:
+        for (idx, par), off in zip(self._levels, self._level_offsets, strict=True):
             rp = rw[..., par, :, :]
             rw[..., idx, :, :] = rp @ rl[..., idx, :, :]
-            wpos[..., idx, :] = wpos[..., par, :] + (rp @ self._offset_cols[idx])[..., 0]
+            wpos[..., idx, :] = wpos[..., par, :] + (rp @ off)[..., 0]
         return wpos, rw
 
     def rest_positions(self, root_position: np.ndarray | None = None) -> np.ndarray:

@@ -7,6 +7,10 @@ socket asks the kernel for SO_TIMESTAMPNS (Linux) and each datagram is given
 to :meth:`~virja.rmcp.transport.RmcpProtocol.receive` at its arrival on the
 session clock: ``now - (wall now - kernel stamp)``.  Where the option is
 missing the read time is used, as asyncio would.
+
+Linux turns arrival stamping on a moment after the first socket asks for it (a
+deferred work item): a datagram in that moment, right after ``virja serve`` opens
+its socket, is stamped when read (tests/rmcp/test_stamped.py waits for it).
 """
 
 from __future__ import annotations

@@ -323,6 +323,10 @@ def _apart_detour(
             back[1] = 0.0
             back = back / max(float(np.linalg.norm(back)), 1e-9)
             tries.append((amp, 0.0, free[h], h, amp * back))
+            past = both[1 - h][2][k] - both[1 - h][1][k]
+            past[1] = 0.0
+            past = past / max(float(np.linalg.norm(past)), 1e-9)
+            tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
     for pad in HOLD_PAD_S:
         for amp, _up, _free_s, h, vec in tries:

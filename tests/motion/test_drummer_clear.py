@@ -199,6 +199,16 @@ def test_the_left_stick_leaving_the_hihat_for_the_snare_stays_over_it(
     _meets_targets(_report(path, 12.0, live))
 
 
+def test_a_left_stick_coming_down_through_the_crossed_right_one_goes_past_its_tip() -> None:
+    """GMD hip-hop 92, first 4 s: the left hand comes down from the crash (2.587 s) to
+    the snare (3.258 s) through the crossed right stick over the hi-hat (3.16-3.19 s),
+    and at 2.28 s the same across.  The sticks pass through each other upright, so no
+    offset across or up keeps them apart, and pulled back along its own stick the left
+    has 65 ms to its stroke; on main 34d9a8b: stick-stick 2.  The right hand now moves
+    out along the left stick, past its tip."""
+    _meets_targets(_report(GMD / "drummer3_session2_31_hiphop_92_beat_4-4.mid", 4.0, False))
+
+
 def _meets_targets(fig: dict[str, object]) -> None:
     collisions = fig["collisions"]
     assert isinstance(collisions, dict)

@@ -12,7 +12,9 @@ impact of that hand, ramps in and out with smoothstep and holds over the conflic
 
 - **stick against stick**: where the sticks come within ``STICK_TRIGGER_M``, one
   hand moves: across the sticks to ``STICK_CLEAR_M``, or up over the other stick,
-  or back along its own; the least offset that fits between that hand's impacts,
+  or back along its own, or out along the other stick past its tip (a stick passing
+  upright through the other one, the left coming down from the crash to the snare
+  through the crossed right stick: no offset across or up fits); the least offset that fits between that hand's impacts,
   keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
   into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
@@ -306,7 +308,9 @@ def _apart_detour(
     Tried in order of the offset's size, the higher first, then the hand with more
     free time: either hand to either side across the sticks (the left kept on the
     side it comes from, or on the side it goes to), then one hand up, over the other
-    stick, or pulled back along its own stick; each held longer (HOLD_PAD_S) if it
+    stick, pulled back along its own stick, or moved out along the other stick, past
+    its tip (GMD hip-hop 92 at 3.16-3.19 s: the left stick coming down to the snare
+    through the crossed right one, 65 ms before its stroke; the right moves); each held longer (HOLD_PAD_S) if it
     must.  The first that fits between the hand's impacts, keeps the sticks apart over
     its whole window and harms nothing (:func:`_harmless`) is made."""
     a, b = both
@@ -330,6 +334,10 @@ def _apart_detour(
             back[1] = 0.0
             back = back / max(float(np.linalg.norm(back)), 1e-9)
             tries.append((amp, 0.0, free[h], h, amp * back))
+            past = both[1 - h][2][k] - both[1 - h][1][k]
+            past[1] = 0.0
+            past = past / max(float(np.linalg.norm(past)), 1e-9)
+            tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
     for pad in HOLD_PAD_S:
         for amp, _up, _free_s, h, vec in tries:

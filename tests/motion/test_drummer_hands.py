@@ -532,3 +532,44 @@ def test_a_hand_out_of_the_way_steps_aside_once_when_its_track_is_rebuilt_live(
         assert contact_distance(a, p, p.impact)[0] < 1e-4
     w = _wrists(a, np.arange(2.9, 3.3, 1 / 120), "Left")
     assert np.linalg.norm(np.diff(w, axis=0), axis=1).max() * 120 < 5.0
+
+
+def _latin() -> list[PlannedNote]:
+    """GMD drummer8 12_latin_118 at 20.5-21.6 s as planned (hands only)."""
+    return [
+        drum("ride_right_hand", 20.501, 20.681, velocity=79),
+        drum("snare_left_hand", 20.659, 20.859, velocity=6),
+        drum("snare_left_hand", 20.662, 20.862, velocity=49),
+        drum("ride_right_hand", 20.839, 21.019, velocity=38),
+        drum("tom_low_left_hand", 20.956, 21.176, velocity=62),
+        drum("ride_right_hand", 21.004, 21.184, velocity=73),
+        drum("snare_left_hand", 21.075, 21.275, velocity=21),
+        drum("ride_right_hand", 21.366, 21.546, velocity=59),
+    ]
+
+
+@pytest.mark.parametrize("live", [False, True])
+def test_a_fast_squeezed_move_along_the_stick_keeps_its_frames_under_15_cm(
+    library: MotionLibrary, live: bool
+) -> None:
+    """GMD latin 118 at 21.2 s: the left hand goes from the low tom to the snare in 99 ms,
+    35.6 cm of grip along the stick, which a turn about the tip cannot shorten.  Its
+    squeezed move has shorter ramps (peak 1.11x the average, not 1.25x): the wrist
+    moves at most 15 cm between 30 fps frames (14.5 cm; 16.1 cm before), every tip lands
+    on its piece; posed live, frames drawn stay as drawn."""
+    from virja.motion.drummer_hands import _SQUEEZED_FAST, _squeezed
+
+    assert _squeezed(0.356, 0.099) == _SQUEEZED_FAST  # this move
+    notes = _latin()
+    ts = np.arange(20.4, 21.7, 1 / 120)
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    if live:
+        drawn = pose_live(a, notes, ts, _known_at)
+        assert_same_frames(a, ts, drawn)
+    else:
+        for p in notes:
+            a.add_planned(p, known_at=_known_at(p))
+    for p in notes:
+        assert contact_distance(a, p, p.impact)[0] < 1e-4, (p.motion, p.impact)
+    assert _jump_30fps(_wrists(a, ts, "Left")) <= 0.15
+    assert _jump_30fps(_wrists(a, ts, "Right")) <= 0.15

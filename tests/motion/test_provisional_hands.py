@@ -97,8 +97,9 @@ def test_a_provisional_hand_leaves_when_the_note_is_known(library: MotionLibrary
     (fast, jump_told), (slow, jump_late) = peaks
     assert fast <= 5.0 and jump_told <= 0.15
     # the case this fixes (the stick's reach takes part of the crossing in the lead
-    # since round 6: 7.1 m/s, was over 8)
-    assert slow > 6.0 and jump_late > 0.15
+    # since round 6: 7.1 m/s, was over 8; since round 8 a squeezed move this fast
+    # peaks at 1.11x its average, not 1.25x: 5.7 m/s, still a 16.3 cm jump)
+    assert slow > 5.0 and jump_late > 0.15
 
 
 def test_the_plan_fixing_the_shown_hand_changes_nothing(library: MotionLibrary) -> None:

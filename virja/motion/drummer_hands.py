@@ -90,6 +90,13 @@ _YIELD_SHARE = 0.6  # out of the way within this share of the time to the other'
 # ramps of this share each, so the peak speed is 1 / (1 - _RAMP) of the average (1.25;
 # smoothstep's is 1.5): the shortest move at bounded speed, not a jump in mid-way
 _SQUEEZED, _RAMP = 4, 0.2
+# ... but where the plan leaves so little time that those ramps would bring the peak
+# near 15 cm a 30 fps frame (average grip speed over 3.4 m/s: 1.25 x 3.4 = 4.25 m/s,
+# 14.2 cm a frame, the rest left for the lift and the body's turn), the ramps are
+# halved (peak 1.11 x the average): GMD latin 118 at 21.2 s, the left hand tom_low ->
+# snare, 35.6 cm of grip in 100 ms along the stick, which the reach cannot shorten
+# (a turn about the tip moves the wrist square to the stick): 15.7 -> 14.4 cm a frame
+_SQUEEZED_FAST, _RAMP_FAST, _FAST_M_S = 6, 0.1, 3.4
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
 _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
@@ -239,22 +246,32 @@ def _shaped(
         np.where(
             prof == _DECEL,
             1.0 - (1.0 - u) ** 2,
-            np.where(prof == _SQUEEZED, _ramped(u), u * u * (3 - 2 * u)),
+            np.where(
+                prof == _SQUEEZED,
+                _ramped(u),
+                np.where(prof == _SQUEEZED_FAST, _ramped(u, _RAMP_FAST), u * u * (3 - 2 * u)),
+            ),
         ),
     )
     return i0, i1, u
 
 
-def _ramped(u: np.ndarray) -> np.ndarray:
-    """The fraction along a :data:`_SQUEEZED` move: ramps of ``_RAMP`` at either end at
-    constant acceleration, constant speed ``1 / (1 - _RAMP)`` between (continuous
+def _ramped(u: np.ndarray, ramp: float = _RAMP) -> np.ndarray:
+    """The fraction along a :data:`_SQUEEZED` move: ramps of ``ramp`` at either end at
+    constant acceleration, constant speed ``1 / (1 - ramp)`` between (continuous
     speed, no step in position)."""
-    v = 1.0 / (1.0 - _RAMP)
+    v = 1.0 / (1.0 - ramp)
     return np.where(
-        u < _RAMP,
-        0.5 * v * u * u / _RAMP,
-        np.where(u > 1.0 - _RAMP, 1.0 - 0.5 * v * (1.0 - u) ** 2 / _RAMP, v * (u - 0.5 * _RAMP)),
+        u < ramp,
+        0.5 * v * u * u / ramp,
+        np.where(u > 1.0 - ramp, 1.0 - 0.5 * v * (1.0 - u) ** 2 / ramp, v * (u - 0.5 * ramp)),
     )
+
+
+def _squeezed(way_m: float, span_s: float) -> int:
+    """The profile of a move of ``way_m`` (grip) squeezed into ``span_s``:
+    :data:`_SQUEEZED_FAST` over ``_FAST_M_S`` on average, else :data:`_SQUEEZED`."""
+    return _SQUEEZED_FAST if way_m > _FAST_M_S * max(span_s, 1e-9) else _SQUEEZED
 
 
 def _shape(u: float, profile: int) -> float:
@@ -264,6 +281,8 @@ def _shape(u: float, profile: int) -> float:
         return 1.0 - (1.0 - u) ** 2
     if profile == _SQUEEZED:
         return float(_ramped(np.asarray(u)))
+    if profile == _SQUEEZED_FAST:
+        return float(_ramped(np.asarray(u), _RAMP_FAST))
     return u * u * (3 - 2 * u)
 
 
@@ -274,15 +293,16 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
     squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first;
     all start and end at rest."""
     moving = (profile == _MOVE) | (profile == _MOVE_OFF_HIHAT)
+    squeezed = (profile == _SQUEEZED) | (profile == _SQUEEZED_FAST)
     lead = np.where(
         moving,
         1.0 - (1.0 - u) ** _RISE_LEAD,
-        np.where(profile == _SQUEEZED, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        np.where(squeezed, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
     )
     lag = np.where(
         profile == _MOVE_OFF_HIHAT,
         u**_HIHAT_LAG,
-        np.where(profile == _SQUEEZED, u**_SQUEEZED_LAG, u**_DROP_LAG),
+        np.where(squeezed, u**_SQUEEZED_LAG, u**_DROP_LAG),
     )
     return np.where(rise > 0, lead, lag)
 
@@ -756,7 +776,7 @@ class DrummerHands:
                 off_hihat = prev_piece == "hihat"
                 _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
-                _add(pt, pv, pp, t, target, _SQUEEZED)
+                _add(pt, pv, pp, t, target, _squeezed(float(way), t - cut))
             if reached is not target:  # known on the way: re-aimed from then
                 assert j is not None
                 _cut(pt, pv, pp, strokes[j][0], _pose_at)

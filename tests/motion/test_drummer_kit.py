@@ -78,3 +78,20 @@ def test_a_closed_stroke_just_before_a_chick_lands_on_shut_cymbals() -> None:
     assert h.chick_weight(0.17) == 0.0
     assert 0.0 < h.chick_weight(0.3) < 1.0
     assert h.chick_weight(0.34) == 1.0
+
+
+def test_a_change_right_after_a_note_waits_for_its_impact() -> None:
+    """MMA's jazz: a foot chick 35 ms before an open stroke.  The chick lands on shut
+    cymbals, the foot lifts after it; the ramp is never longer than lead_s."""
+    h = HihatState(lead_s=0.06, hold_open_s=1.0)
+    h.add(1.0, "pedal")
+    h.add(1.035, "open")
+    h.add(1.08, "closed")
+    assert h.openness(1.0) == 0.0
+    assert 0.0 < h.openness(1.02) < 1.0  # type: ignore[operator]
+    assert h.openness(1.035) == 1.0
+    assert 1.0 > h.openness(1.06) > 0.0  # type: ignore[operator]
+    assert h.openness(1.08) == 0.0
+    h.add(2.0, "open")  # a change far after: still over lead_s only
+    assert h.openness(1.93) == 0.0
+    assert h.openness(1.97) == 0.5

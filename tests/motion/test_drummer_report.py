@@ -136,3 +136,48 @@ def test_an_open_hihat_at_the_instant_of_the_pedal_is_counted_apart(
     assert fig.hihat_contradictory == 2
     assert fig.hihat_notes == 4 and fig.hihat_agreement == 1.0
     assert fig.to_json()["hihat_contradictory"] == 2
+
+
+# Windows of MMA jazz (tools/mma_jazz.py seed 1): drum notes of 0.75 s or less,
+# shifted to start at 0.5 s, with a hi-hat change 35-49 ms after the note before
+# (pedal 44 -> open 46, closed 42 -> open 46).  (time s, note, velocity)
+JAZZ_HIHAT_WINDOWS = {
+    "jazzcombo_180 14.95-15.70 s": (
+        0.333,
+        (
+            (0.5396, 38, 67), (0.5517, 46, 67), (0.7705, 38, 72), (0.866, 44, 70),
+            (0.8798, 36, 69), (0.9007, 46, 78), (1.0899, 42, 88), (1.1021, 44, 74),
+            (1.201, 36, 74), (1.2062, 46, 77),
+        ),
+    ),
+    "modernjazz_300 13.15-13.60 s": (
+        0.2,
+        (
+            (0.5542, 44, 66), (0.5552, 51, 72), (0.649, 51, 67), (0.6542, 44, 78),
+            (0.7031, 46, 77), (0.75, 44, 68), (0.7542, 51, 77), (0.8458, 51, 77),
+            (0.8542, 44, 72), (0.9031, 46, 76),
+        ),
+    ),
+    "bebop_300 13.25-13.45 s": (
+        0.2,
+        ((0.5469, 46, 70), (0.5531, 44, 87), (0.599, 53, 56), (0.6031, 42, 104), (0.6479, 46, 70)),
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("window", sorted(JAZZ_HIHAT_WINDOWS))
+def test_every_hihat_note_lands_on_its_state_in_mma_jazz(
+    library: MotionLibrary, window: str
+) -> None:
+    """A note followed within lead_s by a change lands on its own state: the cymbals
+    start to move only after its impact (issue 15, deliverable 4)."""
+    beat_s, window_notes = JAZZ_HIHAT_WINDOWS[window]
+    notes = [("drums", NoteOn(t, 9, n, v)) for t, n, v in window_notes]
+    planned = plan_notes(notes, ConstantTempo(beat_s))  # type: ignore[arg-type]
+    a = BandAnimator(library)
+    for p in planned:
+        a.add_planned(p)
+    kit = default_config().kit
+    fig = measure_drummer(a, planned, {n: d.articulation for n, d in kit.notes.items()}, fps=60)
+    assert fig.hihat_notes >= 2
+    assert fig.hihat_agreement == 1.0

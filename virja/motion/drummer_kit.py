@@ -5,7 +5,9 @@ where the two cymbals are at its impact; the kit map's ``articulation`` field
 names which (``closed``, ``closed_edge``, ``pedal``, ``open``, ``open_edge``).
 Between notes the cymbals hold the last note's state; a change moves
 linearly over ``lead_s`` before the impact (the foot lifts or presses just
-ahead of the stroke), and an open hi-hat left alone closes again after
+ahead of the stroke), starting no earlier than the note before (which lands
+on its own state: a chick 50 ms before an open stroke is shut at its
+impact, then the foot lifts), and an open hi-hat left alone closes again after
 ``hold_open_s`` (the foot comes back down to rest); before the first note
 they are closed.  Just before a pedal note (a foot chick) the cymbals follow
 the left foot's lift, weighted up to its impact, when the foot presses them
@@ -102,7 +104,13 @@ class HihatState:
         else:
             cur = 0.0
         if upcoming:
-            w = (t - (self._times[n] - self.lead_s)) / self.lead_s
+            # the change starts lead_s ahead, but not before the last note's impact:
+            # that note lands on the state it asks for (a chick 49 ms before an
+            # open stroke is shut, then the foot lifts)
+            start = self._times[n] - self.lead_s
+            if k >= 0:
+                start = max(start, self._times[k])
+            w = (t - start) / (self._times[n] - start)
             cur += (self._open[n] - cur) * min(max(w, 0.0), 1.0)
         return cur
 

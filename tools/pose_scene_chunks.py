@@ -13,9 +13,9 @@ with each tree on ``PYTHONPATH`` in turn (a ``python -c`` in the checkout would 
 the checkout's ``virja`` whatever ``PYTHONPATH`` says; a script's own folder comes
 first instead, and tools/ holds no ``virja``):
 
-    cd /tmp && for i in 1 2 3; do
-      PYTHONPATH=/tmp/before python WORKTREE/tools/pose_scene_chunks.py --label before
-      PYTHONPATH=WORKTREE python WORKTREE/tools/pose_scene_chunks.py --label after; done
+    REPO=$PWD; cd /tmp && for i in 1 2 3; do
+      PYTHONPATH=/tmp/before $REPO/.venv/bin/python $REPO/tools/pose_scene_chunks.py --label before
+      PYTHONPATH=$REPO $REPO/.venv/bin/python $REPO/tools/pose_scene_chunks.py --label after; done
 """
 
 from __future__ import annotations

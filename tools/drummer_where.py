@@ -18,11 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from virja.cli.cmd_motion_report import AS_LIVE_FPS
-from virja.cli.common import performance_settings
+from virja.cli.cmd_motion_report import played
 from virja.cli.main import build_parser
-from virja.config import load_config
-from virja.input import load_performance_input
 from virja.motion.drummer_report import (
     _SK,
     HAND_JOINTS,
@@ -31,7 +28,6 @@ from virja.motion.drummer_report import (
     _sample,
     _segment_distance,
 )
-from virja.pipeline import perform
 from virja.plan.types import PlannedNote
 
 FINE_FPS = 240.0  # as the report's collision and speed sampling, finer than its 120 Hz
@@ -56,15 +52,7 @@ def main() -> int:
     a = ap.parse_args()
     argv = ["motion-report", str(a.file), "--max-seconds", str(a.max_seconds)]
     args = build_parser().parse_args(argv + (["--as-live"] if a.as_live else []))
-    settings = performance_settings(args, load_config(args.config))
-    src = load_performance_input(a.file, settings.routing, lookahead_beats=args.lookahead_beats)
-    perf, planned = perform(
-        settings,
-        src,
-        animate=True,
-        until_s=a.max_seconds,
-        as_live_fps=AS_LIVE_FPS if a.as_live else None,
-    )
+    _settings, perf, planned = played(args)  # as motion-report plays it
     animator = perf.animator
     assert animator is not None
     drums = [p for p in planned if p.performer == "drums"]

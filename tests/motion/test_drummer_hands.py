@@ -215,6 +215,22 @@ def _known_at(p: PlannedNote) -> float:
     return p.impact - 0.5  # read a beat ahead at 120 bpm
 
 
+def _hands_posed(
+    library: MotionLibrary, notes: list[PlannedNote], ts: np.ndarray, live: bool
+) -> BandAnimator:
+    """The hands alone (a still body) given ``notes``, each known a beat ahead
+    (:func:`_known_at`); posed live at ``ts`` (frames drawn must stay as drawn) or
+    with the whole input known."""
+    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
+    if live:
+        drawn = pose_live(a, notes, ts, _known_at)
+        assert_same_frames(a, ts, drawn)
+    else:
+        for p in notes:
+            a.add_planned(p, known_at=_known_at(p))
+    return a
+
+
 def test_a_short_lead_known_a_beat_ahead_moves_from_when_the_note_is_known(
     library: MotionLibrary,
 ) -> None:
@@ -420,13 +436,7 @@ def test_a_far_move_with_little_time_is_partly_taken_by_the_stick(
     tip lands exactly on its piece; posed live, frames drawn stay as drawn."""
     notes = _blues_crash()
     ts = np.arange(6.5, 7.6, 1 / 120)
-    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
-    if live:
-        drawn = pose_live(a, notes, ts, _known_at)
-        assert_same_frames(a, ts, drawn)
-    else:
-        for p in notes:
-            a.add_planned(p, known_at=_known_at(p))
+    a = _hands_posed(library, notes, ts, live)
     for p in notes:
         assert contact_distance(a, p, p.impact)[0] < 1e-4, (p.motion, p.impact)
     assert _jump_30fps(_wrists(a, ts, "Left")) <= 0.15
@@ -562,13 +572,7 @@ def test_a_fast_squeezed_move_along_the_stick_keeps_its_frames_under_15_cm(
     assert _squeezed(0.356, 0.099) == _SQUEEZED_FAST  # this move
     notes = _latin()
     ts = np.arange(20.4, 21.7, 1 / 120)
-    a = BandAnimator(library, body=BodySettings.still(), hands=HANDS_ON)
-    if live:
-        drawn = pose_live(a, notes, ts, _known_at)
-        assert_same_frames(a, ts, drawn)
-    else:
-        for p in notes:
-            a.add_planned(p, known_at=_known_at(p))
+    a = _hands_posed(library, notes, ts, live)
     for p in notes:
         assert contact_distance(a, p, p.impact)[0] < 1e-4, (p.motion, p.impact)
     assert _jump_30fps(_wrists(a, ts, "Left")) <= 0.15

@@ -233,6 +233,22 @@ def test_a_hand_drawn_moving_keeps_its_note_at_the_motions_start(library: Motion
     assert free[49].limb == "left_hand" and b.provisional_counts["revised_moving"] == 1
 
 
+def _as_live(path: Path, until_s: float) -> tuple[Performance, BandAnimator]:
+    """``path``'s first ``until_s`` played as the live window draws it (30 fps, each
+    note known a beat ahead), as ``motion-report --as-live`` does."""
+    settings = PerformanceSettings()
+    perf, _planned = perform(
+        settings,
+        midi_input(path, settings.routing, 1.0),
+        animate=True,
+        until_s=until_s,
+        as_live_fps=30.0,
+    )
+    a = perf.animator
+    assert isinstance(a, BandAnimator)
+    return perf, a
+
+
 def test_as_live_no_note_is_taken_from_a_hand_drawn_moving_toward_it() -> None:
     """GMD drummer5 afro-cuban calypso 124, the first 2 s as live (motion-report
     --as-live): on main the plan gave two notes the left hand at their motion's start
@@ -241,16 +257,7 @@ def test_as_live_no_note_is_taken_from_a_hand_drawn_moving_toward_it() -> None:
     path = (
         ROOT / "tests" / "data" / "gmd" / "drummer5_session1_13_afrocuban-calypso_124_beat_4-4.mid"
     )
-    settings = PerformanceSettings()
-    perf, planned = perform(
-        settings,
-        midi_input(path, settings.routing, 1.0),
-        animate=True,
-        until_s=2.0,
-        as_live_fps=30.0,
-    )
-    a = perf.animator
-    assert isinstance(a, BandAnimator)
+    perf, a = _as_live(path, 2.0)
     counts = a.provisional_counts
     assert counts["fixed_other"] == 0  # main: 2
     assert counts["shown"] > 10 and counts["fixed_same_moving"] >= 2
@@ -271,16 +278,7 @@ def test_a_hand_frozen_just_before_the_others_impact_does_not_step_aside() -> No
         / "gmd"
         / "drummer5_session1_8_latin-venezuelan-merengue_162_beat_5-8.mid"
     )
-    settings = PerformanceSettings()
-    perf, _planned = perform(
-        settings,
-        midi_input(path, settings.routing, 1.0),
-        animate=True,
-        until_s=7.5,
-        as_live_fps=30.0,
-    )
-    a = perf.animator
-    assert isinstance(a, BandAnimator)
+    _perf, a = _as_live(path, 7.5)
     assert a.provisional_counts["revised"] >= 1
     w = _wrists(a, np.arange(6.5, 7.3, 1 / 600))
     assert np.linalg.norm(np.diff(w, axis=0), axis=-1).max() * 600 < 5.0

@@ -35,7 +35,9 @@ from virja.errors import ConfigError, InputFileError
 if TYPE_CHECKING:
     from virja.motion.drummer_report import DrummerFigures
     from virja.motion.metrics import MotionReport, NoteCheck
+    from virja.pipeline import PerformanceSettings
     from virja.plan.types import PlannedNote
+    from virja.session import Performance
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -68,14 +70,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_routing_arguments(parser)
 
 
-def run(args: argparse.Namespace) -> int:
+def played(
+    args: argparse.Namespace,
+) -> tuple[PerformanceSettings, Performance, list[PlannedNote]]:
+    """The settings, the performance and its planned notes for motion-report's arguments: the input
+    planned and animated as every command does (virja.pipeline), its notes, note-offs and
+    beats each revealed --lookahead-beats ahead, the whole input known or as live."""
     from virja.config import load_config
     from virja.input import load_performance_input
+    from virja.pipeline import perform
+
+    settings = performance_settings(args, load_config(args.config))
+    src = load_performance_input(
+        Path(args.input), settings.routing, lookahead_beats=args.lookahead_beats
+    )
+    perf, planned = perform(
+        settings,
+        src,
+        animate=True,
+        until_s=args.max_seconds,
+        as_live_fps=AS_LIVE_FPS if args.as_live else None,
+    )
+    return settings, perf, planned
+
+
+def run(args: argparse.Namespace) -> int:
     from virja.motion.band import BandAnimator
     from virja.motion.bassist_report import measure_bassist
     from virja.motion.drummer_report import measure_drummer
     from virja.motion.metrics import CONTACT_TOLERANCE_M, measure
-    from virja.pipeline import perform
 
     path = Path(args.input)
     if not 1 <= args.fps <= 1000:
@@ -84,17 +107,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--max-seconds must be > 0, got {args.max_seconds:g}")
     if not path.is_file():
         raise InputFileError(path, "no such file")
-    # planned and animated as every command does (virja.pipeline): the file's notes,
-    # note-offs and beats, each revealed --lookahead-beats ahead
-    settings = performance_settings(args, load_config(args.config))
-    src = load_performance_input(path, settings.routing, lookahead_beats=args.lookahead_beats)
-    perf, planned = perform(
-        settings,
-        src,
-        animate=True,
-        until_s=args.max_seconds,
-        as_live_fps=AS_LIVE_FPS if args.as_live else None,
-    )
+    settings, perf, planned = played(args)
     report = perf.planner.report
     animator = perf.animator
     assert isinstance(animator, BandAnimator)

@@ -88,6 +88,13 @@ class FootChain(DrumChain):
             d = min(d, abs(self.state - t))
         return d
 
+    def last_before(self, t: float) -> float | None:
+        """The time of this foot's latest note before ``t``, fixed or pending (None:
+        none)."""
+        times = [ft for ft, _p in self.fixed if ft < t]
+        times += [r.note.time_s for r in self.pending if r.note.time_s < t]
+        return max(times, default=None)
+
     def can_chick(self, t: float) -> bool:
         """The foot plays the hi-hat at ``t`` already (a stroke within HAND_WINDOW_S),
         or can (none within its ``min_interval_s``)."""

@@ -20,7 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from virja.plan import drums as drums_mod
-from virja.plan.chain import GROUP_EPS_S, ChainContext, WindowedPlan
+from virja.plan.chain import GROUP_EPS_S, ChainContext, Held, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
@@ -42,6 +42,9 @@ _MARGIN_S = 1e-6  # the rebound rules look at notes this much further back, then
 
 # one solved group: the hand per stroke (None: dropped), their costs, the state after
 HandStep = tuple[drums_mod.Assignment, tuple[float, ...], drums_mod.HandState]
+# a note a hand plays beyond the solver's strokes: (hand, piece, time, a stroke of its
+# own rather than a bounce of the hand's last stroke)
+Struck = tuple[str, str, float, bool]
 
 
 def velocity_priority(priority: int, velocity: int) -> int:
@@ -195,6 +198,9 @@ class HandsChain(DrumChain):
         self.foot = foot
         self.state: drums_mod.HandState = drums_mod.START
         self.plan: WindowedPlan[HandStep] = WindowedPlan(ctx.bounds.window_groups)
+        # while a group is fixed: the notes its hands play beyond the solver's strokes
+        # (:data:`Struck`), which :func:`_struck` adds to the hands' state
+        self._bounced: list[Struck] | None = None
         self.pin_now = -math.inf  # live: when the pins were last told (:meth:`pin`)
         # the groups and state :meth:`provisional` last solved, and its steps
         self._shown: (
@@ -379,8 +385,13 @@ class HandsChain(DrumChain):
         for gi in range(n_groups):
             hp = prepare(groups[gi])
             assignment, stroke_costs, state = self.plan.step(groups, gi, solve)
-            self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds)
-            self.state = state
+            self._bounced = []
+            self._fix_group(groups[gi], hp, assignment, stroke_costs, rebounds, state)
+            struck = _struck(state, self._bounced)
+            self._bounced = None
+            if struck != state:  # the plan held for later groups knew only the strokes
+                self.forget_plan()
+            self.state = struck
 
     def provisional(self) -> list[PlannedNote]:
         """The hand each pending note would get if nothing more arrived, as planned notes
@@ -460,8 +471,10 @@ class HandsChain(DrumChain):
         assignment: drums_mod.Assignment,
         stroke_costs: tuple[float, ...],
         rebounds: set[int],
+        after: drums_mod.HandState,
     ) -> None:
-        """Emit one group's notes by the solver's ``assignment`` of its strokes."""
+        """Emit one group's notes by the solver's ``assignment`` of its strokes
+        (``after``: the hands' state the solver gives after them)."""
         for r in hp.extra:  # a third hand piece within the window
             if not self.foot.chick(r):
                 self.drop(r, "three_pieces_at_once")
@@ -502,24 +515,56 @@ class HandsChain(DrumChain):
             for r in recs[len(now) :] + bounces:
                 self.emit_bounce(r, stroke.piece, hand)
         for r in late_rebounds:
-            self._emit_rebound(r)
+            self._emit_rebound(r, after)
 
-    def _emit_rebound(self, rec: DrumHeld) -> None:
+    def emit_bounce(self, rec: Held, piece: str, limb: str) -> None:
+        super().emit_bounce(rec, piece, limb)
+        if self._bounced is not None:  # the hand strikes then too (fix_groups, _struck)
+            self._bounced.append((limb, piece, rec.note.time_s, False))
+
+    def _emit_rebound(self, rec: DrumHeld, after: drums_mod.HandState) -> None:
         """``rec`` rides on the latest stroke before it on its piece (see
-        :meth:`_rebounds`); dropped if that stroke was not played."""
+        :meth:`_rebounds`): a hand's, while that hand is still there (``after``: the
+        hands' state after the group), or on the hi-hat the left foot's (a chick or a
+        pedal note: the pad reports the pedal's clamp, or the cymbals' splash, as a
+        soft stroke; GMD rock 102 and 110 have open hi-hat notes of velocity 7-27
+        within 25 ms of a pedal note), or the left foot's chick when the hand that
+        struck has gone on to another piece.  Before round 9 the latest hand stroke on
+        the piece carried it whatever came between: a left hand that had left the
+        hi-hat for a tom 40 ms before was drawn back to the hi-hat and 11 ms later on
+        the tom again (GMD rock 102, 39 m/s).  When no limb is there (what it rode on
+        was dropped, or the hand has left and the foot cannot) it is a stroke of its
+        own (:meth:`place_stroke`; once in the GMD corpus)."""
         t = rec.note.time_s
+        piece = rec.drum.piece
         by = next(
-            (p for ft, p in reversed(self.fixed) if p.piece == rec.drum.piece and ft < t),
+            ((ft, p) for ft, p in reversed(self.fixed) if p.piece == piece and ft < t),
             None,
         )
-        if by is None:
-            self.drop(rec, "too_fast")
-        else:
-            self.emit_bounce(rec, rec.drum.piece, by.limb)
+        if piece == "hihat":
+            foot_t = self.foot.last_before(t)
+            if foot_t is not None and (by is None or foot_t >= by[0]) and self.foot.chick(rec):
+                return
+        if by is not None and self._still_on(by[1].limb, piece, t, after):
+            self.emit_bounce(rec, piece, by[1].limb)
+        elif not self.foot.chick(rec):
+            self.place_stroke(rec, self.ctx.config.timing.get(piece).min_interval_s)
+
+    def _still_on(self, limb: str, piece: str, t: float, after: drums_mod.HandState) -> bool:
+        """Whether hand ``limb`` is on ``piece`` at ``t`` by ``after`` (the hands' state
+        after the group being fixed): its last stroke there, or its stroke on another
+        piece far enough after ``t`` to reach it from there."""
+        _prev, _pt, t_right, t_left, p_right, p_left = after
+        last, on = (t_right, p_right) if limb == drums_mod.RIGHT else (t_left, p_left)
+        if on is None or on == piece or last is None:
+            return True
+        gap = self.ctx.config.timing.stretch_gap(piece, on)
+        return last - t >= gap - drums_mod.TIME_EPS_S
 
     def place_stroke(self, rec: DrumHeld, min_interval_s: float) -> None:
         """The free hand cheapest by the table from the fixed motion before ``rec``
-        (none after a rest), or dropped (``no_free_limb``)."""
+        (none after a rest), or dropped (``no_free_limb``).  While a group is fixed the
+        hand's state then has it as its last stroke (:func:`_struck`)."""
         t = rec.note.time_s
         costs = self.ctx.config.costs
         before = [(ft, p) for ft, p in self.fixed if ft < t - GROUP_EPS_S]
@@ -536,6 +581,30 @@ class HandsChain(DrumChain):
             return
         cost, hand = min(choices)
         self.emit_stroke([rec], rec.drum.piece, hand, cost)
+        if self._bounced is not None:
+            self._bounced.append((hand, rec.drum.piece, t, True))
+
+
+def _struck(state: drums_mod.HandState, bounced: list[Struck]) -> drums_mod.HandState:
+    """``state`` with each hand's last stroke moved to the latest note it played beyond
+    the solver's strokes: on a bounce (a rebound, a buzz, a drag's second note) on the
+    piece it is on, the hand strikes there then and leaves for another piece only
+    after that; a stroke of its own (``moved``) puts it on that piece then.  The solver
+    sees a group's strokes, not the notes riding on them; before round 9 a right hand
+    with ghost notes on the snare 48 ms after its stroke (GMD funk 92) was sent to the
+    hi-hat 6 ms after the last of them (74 m/s of stick tip)."""
+    if not bounced:
+        return state
+    prev, prev_t, t_right, t_left, p_right, p_left = state
+    for limb, piece, t, moved in bounced:
+        if limb == drums_mod.RIGHT:
+            if (t_right is None or t > t_right) and (moved or piece == p_right):
+                t_right, p_right = t, piece
+        elif (
+            limb == drums_mod.LEFT and (t_left is None or t > t_left) and (moved or piece == p_left)
+        ):
+            t_left, p_left = t, piece
+    return (prev, prev_t, t_right, t_left, p_right, p_left)
 
 
 def _unfixed(rec: DrumHeld, piece: str, hand: str, timed: DrumHeld) -> PlannedNote:

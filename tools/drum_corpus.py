@@ -8,8 +8,9 @@ Each file goes through the same planner as `virja plan FILE` (notes read
 whole corpus and per pitch (with the kit map's name and piece), the notes no
 kit drummer plays (routed to nobody), late notes, and the files with the most
 drops (--show N).  Exit status 1 when any kit note
-was dropped for a reason other than three_pieces_at_once (three or more hand pieces
-within the grouping window, which no two hands can play).
+was dropped for a reason other than a physical limit (virja.plan.types.PHYSICAL_LIMITS:
+three or more hand pieces within the grouping window, which no two hands can play, or a
+note no hand reaches without passing 7 m/s of stick tip).
 """
 
 from __future__ import annotations
@@ -22,8 +23,9 @@ from pathlib import Path
 
 from virja.input import midi_input
 from virja.pipeline import PerformanceSettings, perform
+from virja.plan.types import PHYSICAL_LIMITS
 
-ALLOWED = {"three_pieces_at_once"}
+ALLOWED = PHYSICAL_LIMITS
 
 
 Result = tuple[str, Counter[str], Counter[str], int, int, Counter[tuple[int, str]]]

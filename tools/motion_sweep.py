@@ -32,6 +32,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
+from virja.plan.types import PHYSICAL_LIMITS
+
 ROOT = Path(__file__).resolve().parent.parent
 
 # the 19 files of docs/motion.md "The hand with time" (GMD paths under --gmd,
@@ -136,7 +138,7 @@ def misses(row: dict[str, Any]) -> list[str]:
         out.append("collisions")
     if row["hihat_agreement"] is not None and row["hihat_agreement"] < 1.0:
         out.append("hihat")
-    if any(k != "three_pieces_at_once" for k in row["dropped"]):
+    if any(k not in PHYSICAL_LIMITS for k in row["dropped"]):
         out.append("dropped")
     return out
 

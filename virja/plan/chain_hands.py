@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from virja.plan import drums as drums_mod
@@ -24,7 +24,7 @@ from virja.plan.chain import GROUP_EPS_S, ChainContext, Held, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
 from virja.plan.config import DrumNote
-from virja.plan.types import PlannedNote
+from virja.plan.types import DropReason, PlannedNote
 from virja.vocab import Hand
 
 # Notes of one piece this close are one stroke heard twice (head and rim, a pad's
@@ -35,6 +35,12 @@ SAME_STROKE_S = 0.010
 BUZZ_VELOCITY = 48  # ghost notes and soft drag notes (below mezzo-piano)
 BUZZ_S = 0.050
 BUZZ_PIECES = frozenset({"snare", "tom_high", "tom_low", "tom_floor", "hihat", "ride"})
+
+# A note this soft is a touch: round 9 found GMD's notes that no hand could reach
+# without passing 7 m/s of tip (beyond_hand_speed) to be mostly of velocity 5-27 with a
+# loud note on another pad; a hi-hat of velocity 7 kept its hand from a high tom of 58
+# (the tom dropped) when the two weighed alike
+TOUCH_VELOCITY = 20
 
 # where a hand that has struck nothing yet waits: its ready pose, the stick over the snare
 REST_PIECE = "snare"
@@ -48,9 +54,12 @@ Struck = tuple[str, str, float, bool]
 
 
 def velocity_priority(priority: int, velocity: int) -> int:
-    """A note's priority weighed by its velocity (lower = more important): a ghost
-    note (velocity < 40) gives way first, a soft one (< 64) next, an accent (>= 100)
-    is kept before a plain stroke of its piece."""
+    """A note's priority weighed by its velocity (lower = more important): a touch
+    (velocity < 20, no louder than an electronic pad's cross-talk) gives way first,
+    whatever its piece, a ghost note (< 40) next, a soft one (< 64) next, an accent
+    (>= 100) is kept before a plain stroke of its piece."""
+    if velocity < TOUCH_VELOCITY:
+        return priority + 6
     if velocity < 40:
         return priority + 3
     if velocity < 64:
@@ -475,9 +484,11 @@ class HandsChain(DrumChain):
     ) -> None:
         """Emit one group's notes by the solver's ``assignment`` of its strokes
         (``after``: the hands' state the solver gives after them)."""
+        third: set[str] = set()  # the pieces dropped as a third hand piece
         for r in hp.extra:  # a third hand piece within the window
             if not self.foot.chick(r):
                 self.drop(r, "three_pieces_at_once")
+                third.add(r.drum.piece)
         late_rebounds = [r for r in group if r.seq in rebounds] if rebounds else []
         for r in group:
             if r.to_foot and not self.foot.chick(r):
@@ -501,9 +512,10 @@ class HandsChain(DrumChain):
                     self.emit_bounce(r, stroke.piece, hand)
                 continue
             if hand is None:
+                why = self._unplayed_why(stroke.piece, hp.group.time + stroke.dt)
                 for r in recs + bounces:
                     if not self.foot.chick(r):
-                        self.drop(r, "too_fast")
+                        self.drop(r, why)
                 continue
             if len(recs) == 1:  # most strokes: one note, nothing riding on it
                 self.emit_stroke(recs, stroke.piece, hand, stroke_costs[si])
@@ -515,7 +527,24 @@ class HandsChain(DrumChain):
             for r in recs[len(now) :] + bounces:
                 self.emit_bounce(r, stroke.piece, hand)
         for r in late_rebounds:
-            self._emit_rebound(r, after)
+            if r.drum.piece in third:  # a bounce of the third piece's stroke, not played
+                self.drop(r, "three_pieces_at_once")
+            else:
+                self._emit_rebound(r, after)
+
+    def _unplayed_why(self, piece: str, t: float) -> DropReason:
+        """Why the solver gave a stroke on ``piece`` at ``t`` no hand (while its group is
+        fixed, from the hands' state before the group): ``beyond_hand_speed`` when a hand
+        could strike it in time (:meth:`Timing.stretch_gap` from that hand's last
+        stroke), so what kept it off is the speed of a move, its own or one it forces
+        (timing.toml [hand_speed]'s top tier, past a drummer's hands); ``too_fast`` when
+        no hand could strike again so soon."""
+        timing = self.ctx.config.timing
+        _prev, _pt, t_right, t_left, p_right, p_left = self.state
+        for last, on in ((t_right, p_right), (t_left, p_left)):
+            if last is None or t - last >= timing.stretch_gap(on, piece) - drums_mod.TIME_EPS_S:
+                return "beyond_hand_speed"
+        return "too_fast"
 
     def emit_bounce(self, rec: Held, piece: str, limb: str) -> None:
         super().emit_bounce(rec, piece, limb)
@@ -548,7 +577,39 @@ class HandsChain(DrumChain):
         if by is not None and self._still_on(by[1].limb, piece, t, after):
             self.emit_bounce(rec, piece, by[1].limb)
         elif not self.foot.chick(rec):
-            self.place_stroke(rec, self.ctx.config.timing.get(piece).min_interval_s)
+            self._own_stroke(rec, after)
+
+    def _own_stroke(self, rec: DrumHeld, after: drums_mod.HandState) -> None:
+        """A rebound with nothing to ride on, as a stroke of its own: by a free hand that
+        reaches it from its stroke before or after (``after``: the hands' state after
+        the group) under the top speed of timing.toml [hand_speed] (:meth:`place_stroke`),
+        else dropped as the solver drops a stroke: ``beyond_hand_speed`` when a hand
+        reaches it at a stretch only past that speed, ``too_fast`` when none can (GMD
+        bossa 127 at 285.8 s: a side stick 38 ms after the left hand's low tom, 0.46 m
+        away, riding on a snare note dropped as a third piece)."""
+        t, piece = rec.note.time_s, rec.drum.piece
+        timing = self.ctx.config.timing
+        top = max((pen for _speed, pen in timing.speed_tiers), default=math.inf)
+        _prev, _pt, t_right, t_left, p_right, p_left = after
+        fit: list[Hand] = []
+        reached = False
+        for hand, last, on in (
+            (drums_mod.RIGHT, t_right, p_right),
+            (drums_mod.LEFT, t_left, p_left),
+        ):
+            if last is None or on is None:
+                fit.append(hand)
+                continue
+            a, b = (on, piece) if last <= t else (piece, on)
+            since = abs(t - last)
+            if since >= timing.stretch_gap(a, b) - drums_mod.TIME_EPS_S:
+                reached = True
+                if drums_mod.stroke_penalty(timing, a, b, since) < top:
+                    fit.append(hand)
+        if fit:
+            self.place_stroke(rec, timing.get(piece).min_interval_s, fit)
+        else:
+            self.drop(rec, "beyond_hand_speed" if reached else "too_fast")
 
     def _still_on(self, limb: str, piece: str, t: float, after: drums_mod.HandState) -> bool:
         """Whether hand ``limb`` is on ``piece`` at ``t`` by ``after`` (the hands' state
@@ -561,10 +622,15 @@ class HandsChain(DrumChain):
         gap = self.ctx.config.timing.stretch_gap(piece, on)
         return last - t >= gap - drums_mod.TIME_EPS_S
 
-    def place_stroke(self, rec: DrumHeld, min_interval_s: float) -> None:
-        """The free hand cheapest by the table from the fixed motion before ``rec``
-        (none after a rest), or dropped (``no_free_limb``).  While a group is fixed the
-        hand's state then has it as its last stroke (:func:`_struck`)."""
+    def place_stroke(
+        self,
+        rec: DrumHeld,
+        min_interval_s: float,
+        hands: Sequence[Hand] = (drums_mod.LEFT, drums_mod.RIGHT),
+    ) -> None:
+        """The free hand (of ``hands``) cheapest by the table from the fixed motion
+        before ``rec`` (none after a rest), or dropped (``no_free_limb``).  While a group
+        is fixed the hand's state then has it as its last stroke (:func:`_struck`)."""
         t = rec.note.time_s
         costs = self.ctx.config.costs
         before = [(ft, p) for ft, p in self.fixed if ft < t - GROUP_EPS_S]
@@ -573,7 +639,7 @@ class HandsChain(DrumChain):
             row = costs.motions.index(before[-1][1].motion.name)
         choices = [
             (costs.table[row][costs.index(rec.drum.piece, h)], h)
-            for h in (drums_mod.LEFT, drums_mod.RIGHT)
+            for h in hands
             if self.limb_free(h, t, min_interval_s)
         ]
         if not choices:

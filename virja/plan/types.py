@@ -22,6 +22,7 @@ __all__ = [
     "DroppedNote",
     "HandPin",
     "Limb",
+    "PHYSICAL_LIMITS",
     "MovedNote",
     "PlanReport",
     "PlannedNote",
@@ -177,6 +178,10 @@ DropReason = Literal[
     # three or more hand pieces within the grouping window (30 ms), the hi-hat not to the
     # foot: beyond two hands (an electronic kit's pad cross-talk); priority kept the others
     "three_pieces_at_once",
+    # every hand that could strike it would pass the top speed of timing.toml [hand_speed]
+    # (7 m/s of stick tip, the wrist over 8 m/s): beyond a drummer's hands (pad
+    # cross-talk again, or an echo of the pedal); priority kept the others
+    "beyond_hand_speed",
     "too_fast",  # the limb cannot strike again so soon (minimum inter-stroke time)
     "no_free_limb",  # came after later notes of its limbs were fixed, and no limb was free then
     "unmapped",  # a drum note outside the kit map
@@ -191,6 +196,10 @@ DROP_REASON_TEXT: dict[str, str] = {
         "three or more hand pieces within 30 ms: beyond two hands, as an electronic "
         "kit's pad cross-talk makes"
     ),
+    "beyond_hand_speed": (
+        "no hand reaches it without passing 7 m/s of stick tip: beyond a drummer's "
+        "hands, as an electronic kit's pad cross-talk makes"
+    ),
     "too_fast": "no limb can strike again so soon, even at a stretch",
     "no_free_limb": "arrived after its limbs' later notes were fixed",
     "unmapped": "not in the kit map",
@@ -198,6 +207,10 @@ DROP_REASON_TEXT: dict[str, str] = {
     "too_dense": "more notes around its time than anyone plays",
     "planner_full": "the plan already held the most notes it may wait on",
 }
+
+# the reasons that say the notes asked for more than a drummer's body can do (issue 15's
+# one exception to "no kit note dropped": a physical impossibility)
+PHYSICAL_LIMITS: frozenset[DropReason] = frozenset({"three_pieces_at_once", "beyond_hand_speed"})
 
 
 @dataclass(frozen=True, slots=True)

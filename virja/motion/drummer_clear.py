@@ -14,7 +14,9 @@ impact of that hand, ramps in and out with smoothstep and holds over the conflic
   hand moves: across the sticks to ``STICK_CLEAR_M``, or up over the other stick,
   or back along its own, or out along the other stick past its tip (a stick passing
   upright through the other one, the left coming down from the crash to the snare
-  through the crossed right stick: no offset across or up fits); the least offset that fits between that hand's impacts,
+  through the crossed right stick: no offset across or up fits), as far as it takes
+  to bring one stick's tip around the other's (``_END_PAST_M``); the least offset
+  that fits between that hand's impacts,
   keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
   into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
@@ -48,6 +50,15 @@ STICK_CLEAR_M = 0.035
 # if the least offset does not, one STICK_MORE_M larger is tried
 STICK_APART_M = 0.018
 STICK_MORE_M = 0.02
+# ... and where a stick passes through the other one from under to over (or over to
+# under: the left rising from the snare to the crash, or coming down from it, through the
+# right stick lying crossed over the hi-hat), no offset across or up can hold them apart
+# (a bump only moves the crossing in time); one stick is taken around the other's end:
+# its hand pulled back along its own stick until its tip is this far behind the
+# crossing, or moved along the other stick until that one's tip is (GMD sample from
+# offset 8, round 9: all 8 stick-stick runs left were such passes, the tip 12-17 cm
+# past the other stick, more than UP_M's largest; 4 are now made, 16-17.6 cm)
+_END_PAST_M = 0.03
 # a hand lifted over the other stick, or pulled back along its own stick out of the
 # other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these);
 # the last is about the most a ramp allows (RAMP_SPEED_M_S x RAMP_MAX_S / 1.5 = 16 cm):
@@ -64,7 +75,9 @@ RIM_MARGIN_M = 0.01
 # (the downstroke lands exactly where it was planned)
 AFTER_IMPACT_S = 0.006
 BEFORE_IMPACT_S = 0.03
-RAMP_MAX_S = 0.08  # ramps no longer than this (a detour is local)
+# ramps no longer than this (a detour is local), unless its amplitude needs a longer one
+# at RAMP_SPEED_M_S (_END_PAST_M: 16-17.6 cm, 83-88 ms): as local as its speed allows
+RAMP_MAX_S = 0.08
 # a move detour holds this much longer on either side of its conflict, where it fits
 # (the least that keeps the sticks apart over the whole window): the sticks move on,
 # and held over the conflict alone the crossing came back just after it (GMD hiphop
@@ -216,8 +229,9 @@ def _window(
         t1 = t2 = min(max(mid, lo + need), hi - need)
         if lo + need > hi - need:
             return None
-    ramp_in = min(RAMP_MAX_S, t1 - lo)
-    ramp_out = min(RAMP_MAX_S, hi - t2)
+    longest = max(RAMP_MAX_S, need)  # see RAMP_MAX_S
+    ramp_in = min(longest, t1 - lo)
+    ramp_out = min(longest, hi - t2)
     # a ramp clamped to the least it may be (t1 = lo + need) comes back from the
     # subtraction an ulp short of ``need``: compared exactly, such a detour was never
     # made (as live, MMA Swing1 at 240 bpm at 10.68 s: the left tip 66 mm under the
@@ -293,6 +307,12 @@ def _harmless(
     return jn <= max(jo, JUMP_OK_M) and sn <= max(so, SPEED_OK_M_S)
 
 
+def _to_tip(point: np.ndarray, tip: np.ndarray, back: np.ndarray) -> float:
+    """How far (m) ``tip`` (3,) lies ahead of ``point`` (3,) against the horizontal
+    direction ``back`` (unit, (3,)): the stick's length to pull back past a crossing."""
+    return max(float((point - tip) @ back), 0.0)
+
+
 def _apart_detour(
     t: np.ndarray,
     both: tuple[Stick, Stick],
@@ -310,8 +330,9 @@ def _apart_detour(
     side it comes from, or on the side it goes to), then one hand up, over the other
     stick, pulled back along its own stick, or moved out along the other stick, past
     its tip (GMD hip-hop 92 at 3.16-3.19 s: the left stick coming down to the snare
-    through the crossed right one, 65 ms before its stroke; the right moves); each held longer (HOLD_PAD_S) if it
-    must.  The first that fits between the hand's impacts, keeps the sticks apart over
+    through the crossed right one, 65 ms before its stroke; the right moves), by the
+    amounts of UP_M and by as far as takes one tip around the other stick
+    (_END_PAST_M); each held longer (HOLD_PAD_S) if it must.  The first that fits between the hand's impacts, keeps the sticks apart over
     its whole window and harms nothing (:func:`_harmless`) is made."""
     a, b = both
     i, j = run
@@ -327,16 +348,26 @@ def _apart_detour(
                 vec = (amp if h == 0 else -amp) * side * n
                 tries.append((amp, -vec[1], free[h], h, vec))
     k = i + int(np.argmin(np.linalg.norm(gap[i : j + 1], axis=1)))
-    for amp in UP_M:
-        for h, stick in enumerate(both):
+    near = segment_closest(a[1][k : k + 1], a[2][k : k + 1], b[1][k : k + 1], b[2][k : k + 1])
+    for h, stick in enumerate(both):
+        back = stick[1][k] - stick[2][k]
+        back[1] = 0.0
+        back = back / max(float(np.linalg.norm(back)), 1e-9)
+        past = both[1 - h][2][k] - both[1 - h][1][k]
+        past[1] = 0.0
+        past = past / max(float(np.linalg.norm(past)), 1e-9)
+        for amp in UP_M:
             tries.append((amp, -amp, free[h], h, np.array([0.0, amp, 0.0])))
-            back = stick[1][k] - stick[2][k]
-            back[1] = 0.0
-            back = back / max(float(np.linalg.norm(back)), 1e-9)
             tries.append((amp, 0.0, free[h], h, amp * back))
-            past = both[1 - h][2][k] - both[1 - h][1][k]
-            past[1] = 0.0
-            past = past / max(float(np.linalg.norm(past)), 1e-9)
+            tries.append((amp, 0.0, free[h], h, amp * past))
+        # around the end: pulled back until its own tip, or moved along the other
+        # stick until that one's tip, is behind the crossing (a stick passing through
+        # the other one from under to over: no offset across or up fits)
+        own = _to_tip(near[h][0], stick[2][k], back)
+        other = _to_tip(near[1 - h][0], both[1 - h][2][k], -past)
+        for amp in (own + _END_PAST_M, own + _END_PAST_M + STICK_MORE_M):
+            tries.append((amp, 0.0, free[h], h, amp * back))
+        for amp in (other + _END_PAST_M, other + _END_PAST_M + STICK_MORE_M):
             tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
     for pad in HOLD_PAD_S:

@@ -19,6 +19,7 @@ impact of that hand, ramps in and out with smoothstep and holds over the conflic
   that fits between that hand's impacts,
   keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
   into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
+  where no one hand's fits, both hands move, each half of one of those offsets;
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
   wrist stays where it is) until the tip is ``SURFACE_CLEAR_M`` over the surface:
   over the rim, not through the cymbal.  (Moving the whole hand up instead added up
@@ -173,26 +174,26 @@ def _apart_over(
     t: np.ndarray,
     a: Stick,
     b: Stick,
-    h: int,
-    w: Window,
-    vec: np.ndarray,
+    moved: Sequence[tuple[int, Window, np.ndarray]],
     run: tuple[int, int],
 ) -> bool:
-    """Whether hand ``h`` moved by a detour (window ``w``, offset ``vec``) keeps the two
+    """Whether the hands moved by detours ``moved`` (hand, window, offset) keep the two
     sticks (``a`` left, ``b`` right, sampled at ``t``) at least STICK_APART_M apart over
     the whole window and the conflict's samples ``run`` (a detour found on the nearest
     sample alone could push the crossing a few ms on, or push the stick through the
     other one; one squeezed before its hand's impact could end before the conflict
     begins and leave it as it was: GMD hiphop 110 at 6.27 s, a right-hand detour over
     6.14-6.25 s for sticks crossing at 6.26-6.27 s, 10 ms before its hi-hat stroke)."""
-    i = min(int(np.searchsorted(t, w[0])), run[0])
-    j = max(int(np.searchsorted(t, w[3], side="right")), run[1] + 1)
+    i = min([int(np.searchsorted(t, w[0])) for _h, w, _v in moved] + [run[0]])
+    j = max([int(np.searchsorted(t, w[3], side="right")) for _h, w, _v in moved] + [run[1] + 1])
     if j <= i:
         return True
-    off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
-    sa = [p[i:j] + (off if h == 0 else 0.0) for p in a[1:]]
-    sb = [p[i:j] + (off if h == 1 else 0.0) for p in b[1:]]
-    pa, pb = segment_closest(sa[0], sa[1], sb[0], sb[1])
+    sides = [[p[i:j] for p in s[1:]] for s in (a, b)]
+    for h, w, vec in moved:
+        off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
+        sides[h] = [p + off for p in sides[h]]
+    (a0, a1), (b0, b1) = sides
+    pa, pb = segment_closest(a0, a1, b0, b1)
     return bool(np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M)
 
 
@@ -321,8 +322,8 @@ def _apart_detour(
     impacts: Sequence[Sequence[float]],
     kit: DrumKit,
     floor: float,
-) -> tuple[int, Detour] | None:
-    """(hand, detour) keeping the two sticks apart over the samples ``run`` where they
+) -> list[tuple[int, Detour]] | None:
+    """[(hand, detour)] keeping the two sticks apart over the samples ``run`` where they
     come near (``gap``: left minus right closest points), or None.
 
     Tried in order of the offset's size, the higher first, then the hand with more
@@ -332,8 +333,11 @@ def _apart_detour(
     its tip (GMD hip-hop 92 at 3.16-3.19 s: the left stick coming down to the snare
     through the crossed right one, 65 ms before its stroke; the right moves), by the
     amounts of UP_M and by as far as takes one tip around the other stick
-    (_END_PAST_M); each held longer (HOLD_PAD_S) if it must.  The first that fits between the hand's impacts, keeps the sticks apart over
-    its whole window and harms nothing (:func:`_harmless`) is made."""
+    (_END_PAST_M); each held longer (HOLD_PAD_S) if it must.  The first that fits
+    between the hand's impacts, keeps the sticks apart over its whole window and harms
+    nothing (:func:`_harmless`) is made; if none, the same offsets (between the
+    sticks) are tried again shared, half by each hand, and the first that fits for
+    both is made (two detours)."""
     a, b = both
     i, j = run
     n = _apart(a, b, gap, i, j)
@@ -375,10 +379,27 @@ def _apart_detour(
             w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
             if (
                 w is not None
-                and _apart_over(t, a, b, h, w, vec, run)
+                and _apart_over(t, a, b, [(h, w, vec)], run)
                 and _harmless(t, both[h], w, vec, kit)
             ):
-                return h, Detour(w[0], w[1], w[2], w[3], vec)
+                return [(h, Detour(w[0], w[1], w[2], w[3], vec))]
+    # both hands give way, each half the offset between the sticks (the left's minus
+    # the right's) that one hand alone had no time or room for: each ramp needs half
+    # the time at RAMP_SPEED_M_S (GMD rock half-time 140 fill at 0.43 and 0.61 s: a
+    # left tom stroke from under the right stick crossed over the hi-hat, the right
+    # landing inside the first crossing, the left's stroke 26 ms after the second)
+    for pad in HOLD_PAD_S:
+        for amp, _up, _free_s, h, vec in tries:
+            half = 0.5 * (vec if h == 0 else -vec)
+            moved = []
+            for g, v in ((0, half), (1, -half)):
+                w = _window(impacts[g], t_in, t_out, floor, 0.5 * amp, pad=pad)
+                if w is None or not _harmless(t, both[g], w, v, kit):
+                    break
+                moved.append((g, w, v))
+            else:
+                if _apart_over(t, a, b, moved, run):
+                    return [(g, Detour(w[0], w[1], w[2], w[3], v)) for g, w, v in moved]
     return None
 
 
@@ -460,8 +481,8 @@ def detours_in(
         for i, j in _runs(d < STICK_CLEAR_M):
             if d[i : j + 1].min() < STICK_TRIGGER_M:
                 found = _apart_detour(t, (left, right), gap, (i, j), impacts, sampled.kit, floor)
-                if found is not None:
-                    out[found[0]].append(found[1])
+                for h, made in found or ():
+                    out[h].append(made)
     for h, heights in enumerate(sampled.heights):
         for hgt, inside in heights:
             for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):

@@ -117,13 +117,15 @@ def test_two_sticks_crossing_are_kept_apart_by_one_hand() -> None:
     assert np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M - 1e-9
 
 
-def test_a_stick_rising_upright_through_the_other_goes_around_its_end() -> None:
+@pytest.mark.parametrize("right_busy", [False, True])
+def test_a_stick_rising_upright_through_the_other_goes_around_its_end(right_busy: bool) -> None:
     """A left stick rising straight up through a right one lying still across it (an
-    X seen from above, the left's tip 15 cm past the crossing, the right's 20 cm), no
-    impacts near: no offset across or up can keep them apart (the left goes from
-    under the right to over it), and pulled back the UP_M amounts at most (15.5 cm)
-    its tip still crosses; on main 6e92c30 no detour was made.  Now one stick goes
-    around the other's end, the sticks stay apart."""
+    X seen from above, the left's tip 15 cm past the crossing, the right's 20 cm): no
+    offset across or up can keep them apart (the left goes from under the right to
+    over it), and pulled back the UP_M amounts at most (15.5 cm) the left's tip still
+    crosses; on main 6e92c30 no detour was made.  Now one tip goes around the other
+    stick: both hands share the offset between them; with the right striking in the
+    middle of the crossing, the left alone, on a ramp longer than RAMP_MAX_S."""
     t = np.arange(0.0, 1.0, 1 / 240)
     n = t.size
     y = 1.8 + 0.4 * t  # the left passes the right's height (2.0) at t = 0.5
@@ -141,14 +143,13 @@ def test_a_stick_rising_upright_through_the_other_goes_around_its_end() -> None:
 
         return at
 
-    impacts = [[-1.0, 2.0], [-1.0, 2.0]]
+    impacts = [[-1.0, 2.0], [-1.0, 0.5, 2.0] if right_busy else [-1.0, 2.0]]
     moves, _lifts = detours([of(left), of(right)], impacts, GEOMETRY.kit, (0.0, 1.0), -np.inf)
-    made = [(h, d) for h in (0, 1) for d in moves[h]]
-    assert len(made) == 1
-    h, d = made[0]
-    assert float(np.linalg.norm(d.vec)) > max(UP_M)
-    la = [c + (offsets([d], t) if h == 0 else 0.0) for c in left[1:]]
-    ra = [c + (offsets([d], t) if h == 1 else 0.0) for c in right[1:]]
+    assert [len(m) for m in moves] == ([1, 0] if right_busy else [1, 1])
+    la = [c + offsets(moves[0], t) for c in left[1:]]
+    ra = [c + offsets(moves[1], t) for c in right[1:]]
+    between = offsets(moves[0], np.array([0.5])) - offsets(moves[1], np.array([0.5]))
+    assert float(np.linalg.norm(between)) > max(UP_M)
     pa, pb = segment_closest(la[0], la[1], ra[0], ra[1])
     assert np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M - 1e-9
 

@@ -19,7 +19,8 @@ impact of that hand, ramps in and out with smoothstep and holds over the conflic
   that fits between that hand's impacts,
   keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
   into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
-  where no one hand's fits, both hands move, each half of one of those offsets;
+  where no one hand's fits within a ramp of ``RAMP_MAX_S``, both hands move, each
+  half of one of those offsets, and only then one hand on a longer ramp;
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
   wrist stays where it is) until the tip is ``SURFACE_CLEAR_M`` over the surface:
   over the rim, not through the cymbal.  (Moving the whole hand up instead added up
@@ -58,7 +59,7 @@ STICK_MORE_M = 0.02
 # its hand pulled back along its own stick until its tip is this far behind the
 # crossing, or moved along the other stick until that one's tip is (GMD sample from
 # offset 8, round 9: all 8 stick-stick runs left were such passes, the tip 12-17 cm
-# past the other stick, more than UP_M's largest; 4 are now made, 16-17.6 cm)
+# past the other stick, more than UP_M's largest)
 _END_PAST_M = 0.03
 # a hand lifted over the other stick, or pulled back along its own stick out of the
 # other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these);
@@ -77,7 +78,8 @@ RIM_MARGIN_M = 0.01
 AFTER_IMPACT_S = 0.006
 BEFORE_IMPACT_S = 0.03
 # ramps no longer than this (a detour is local), unless its amplitude needs a longer one
-# at RAMP_SPEED_M_S (_END_PAST_M: 16-17.6 cm, 83-88 ms): as local as its speed allows
+# at RAMP_SPEED_M_S (_END_PAST_M, 16-20 cm: 80-100 ms), as local as its speed allows,
+# and tried after both hands sharing the offset (_apart_detour)
 RAMP_MAX_S = 0.08
 # a move detour holds this much longer on either side of its conflict, where it fits
 # (the least that keeps the sticks apart over the whole window): the sticks move on,
@@ -335,9 +337,9 @@ def _apart_detour(
     amounts of UP_M and by as far as takes one tip around the other stick
     (_END_PAST_M); each held longer (HOLD_PAD_S) if it must.  The first that fits
     between the hand's impacts, keeps the sticks apart over its whole window and harms
-    nothing (:func:`_harmless`) is made; if none, the same offsets (between the
-    sticks) are tried again shared, half by each hand, and the first that fits for
-    both is made (two detours)."""
+    nothing (:func:`_harmless`) is made, first among those one ramp of RAMP_MAX_S
+    takes (16 cm); if none, the same offsets (between the sticks) shared, half by each
+    hand (two detours); then one hand alone on a longer ramp."""
     a, b = both
     i, j = run
     n = _apart(a, b, gap, i, j)
@@ -374,32 +376,44 @@ def _apart_detour(
         for amp in (other + _END_PAST_M, other + _END_PAST_M + STICK_MORE_M):
             tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
-    for pad in HOLD_PAD_S:
-        for amp, _up, _free_s, h, vec in tries:
-            w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
-            if (
-                w is not None
-                and _apart_over(t, a, b, [(h, w, vec)], run)
-                and _harmless(t, both[h], w, vec, kit)
-            ):
-                return [(h, Detour(w[0], w[1], w[2], w[3], vec))]
-    # both hands give way, each half the offset between the sticks (the left's minus
-    # the right's) that one hand alone had no time or room for: each ramp needs half
-    # the time at RAMP_SPEED_M_S (GMD rock half-time 140 fill at 0.43 and 0.61 s: a
-    # left tom stroke from under the right stick crossed over the hi-hat, the right
-    # landing inside the first crossing, the left's stroke 26 ms after the second)
-    for pad in HOLD_PAD_S:
-        for amp, _up, _free_s, h, vec in tries:
-            half = 0.5 * (vec if h == 0 else -vec)
-            moved = []
-            for g, v in ((0, half), (1, -half)):
-                w = _window(impacts[g], t_in, t_out, floor, 0.5 * amp, pad=pad)
-                if w is None or not _harmless(t, both[g], w, v, kit):
-                    break
-                moved.append((g, w, v))
-            else:
-                if _apart_over(t, a, b, moved, run):
-                    return [(g, Detour(w[0], w[1], w[2], w[3], v)) for g, w, v in moved]
+
+    def alone(longer: bool) -> list[tuple[int, Detour]] | None:
+        for pad in HOLD_PAD_S:
+            for amp, _up, _free_s, h, vec in tries:
+                if (1.5 * amp / RAMP_SPEED_M_S > RAMP_MAX_S + _TIME_EPS_S) != longer:
+                    continue
+                w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
+                if (
+                    w is not None
+                    and _apart_over(t, a, b, [(h, w, vec)], run)
+                    and _harmless(t, both[h], w, vec, kit)
+                ):
+                    return [(h, Detour(w[0], w[1], w[2], w[3], vec))]
+        return None
+
+    def shared() -> list[tuple[int, Detour]] | None:
+        for pad in HOLD_PAD_S:
+            for amp, _up, _free_s, h, vec in tries:
+                half = 0.5 * (vec if h == 0 else -vec)
+                moved = []
+                for g, v in ((0, half), (1, -half)):
+                    w = _window(impacts[g], t_in, t_out, floor, 0.5 * amp, pad=pad)
+                    if w is None or not _harmless(t, both[g], w, v, kit):
+                        break
+                    moved.append((g, w, v))
+                else:
+                    if _apart_over(t, a, b, moved, run):
+                        return [(g, Detour(w[0], w[1], w[2], w[3], v)) for g, w, v in moved]
+        return None
+
+    # one hand alone as far as a ramp of RAMP_MAX_S takes it (16 cm); then both hands
+    # give way, each half the offset between the sticks (the left's minus the
+    # right's), each ramp half as long (GMD rock half-time 140 fill at 0.43 and 0.61 s:
+    # a left tom stroke from under the right stick crossed over the hi-hat, the right
+    # landing inside the first crossing, the left's stroke 26 ms after the second); and
+    # only then one hand alone on a longer ramp (a 16-20 cm pull-back alone, where both
+    # could, doubled the fill's wrist p99 as live: 1.7 -> 3.2 m/s, its jump 6 -> 13 cm)
+    return alone(False) or shared() or alone(True)
     return None
 
 

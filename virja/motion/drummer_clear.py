@@ -377,17 +377,26 @@ def _apart_detour(
             tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
 
+    # a longer hold (HOLD_PAD_S) often gives the same window (held up to an impact):
+    # such a try is not checked again (its checks are pure; it failed)
+    seen: set[tuple[tuple[int, Window, bytes], ...]] = set()
+
+    def fits(moved: list[tuple[int, Window, np.ndarray]]) -> bool:
+        key = tuple((h, w, v.tobytes()) for h, w, v in moved)
+        if key in seen:
+            return False
+        seen.add(key)
+        return _apart_over(t, a, b, moved, run) and all(
+            _harmless(t, both[h], w, v, kit) for h, w, v in moved
+        )
+
     def alone(longer: bool) -> list[tuple[int, Detour]] | None:
         for pad in HOLD_PAD_S:
             for amp, _up, _free_s, h, vec in tries:
                 if (1.5 * amp / RAMP_SPEED_M_S > RAMP_MAX_S + _TIME_EPS_S) != longer:
                     continue
                 w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
-                if (
-                    w is not None
-                    and _apart_over(t, a, b, [(h, w, vec)], run)
-                    and _harmless(t, both[h], w, vec, kit)
-                ):
+                if w is not None and fits([(h, w, vec)]):
                     return [(h, Detour(w[0], w[1], w[2], w[3], vec))]
         return None
 
@@ -398,11 +407,11 @@ def _apart_detour(
                 moved = []
                 for g, v in ((0, half), (1, -half)):
                     w = _window(impacts[g], t_in, t_out, floor, 0.5 * amp, pad=pad)
-                    if w is None or not _harmless(t, both[g], w, v, kit):
+                    if w is None:
                         break
                     moved.append((g, w, v))
                 else:
-                    if _apart_over(t, a, b, moved, run):
+                    if fits(moved):
                         return [(g, Detour(w[0], w[1], w[2], w[3], v)) for g, w, v in moved]
         return None
 

@@ -19,6 +19,7 @@ from virja.motion.drummer_clear import (
     LIFT_BEFORE_S,
     LIFT_SPEED_M_S,
     STICK_APART_M,
+    UP_M,
     Detour,
     Sampled,
     Stick,
@@ -116,6 +117,43 @@ def test_two_sticks_crossing_are_kept_apart_by_one_hand() -> None:
     assert np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M - 1e-9
 
 
+@pytest.mark.parametrize("right_busy", [False, True])
+def test_a_stick_rising_upright_through_the_other_goes_around_its_end(right_busy: bool) -> None:
+    """A left stick rising straight up through a right one lying still across it (an
+    X seen from above, the left's tip 15 cm past the crossing, the right's 20 cm): no
+    offset across or up can keep them apart (the left goes from under the right to
+    over it), and pulled back the UP_M amounts at most (15.5 cm) the left's tip still
+    crosses; on main 6e92c30 no detour was made.  Now one tip goes around the other
+    stick: both hands share the offset between them; with the right striking in the
+    middle of the crossing, the left alone, on a ramp longer than RAMP_MAX_S."""
+    t = np.arange(0.0, 1.0, 1 / 240)
+    n = t.size
+    y = 1.8 + 0.4 * t  # the left passes the right's height (2.0) at t = 0.5
+    left_butt = np.stack([np.zeros(n), y, np.full(n, -0.15)], axis=1)
+    left_tip = left_butt + np.array([0.0, 0.0, 0.4])
+    right_butt = _still(np.array([-0.2, 2.0, 0.1]), n)
+    right_tip = _still(np.array([0.2, 2.0, 0.1]), n)
+    left = (left_butt + np.array([0.0, 0.0, -0.1]), left_butt, left_tip)
+    right = (right_butt + np.array([-0.1, 0.0, 0.0]), right_butt, right_tip)
+
+    def of(stick: Stick) -> Sticks:
+        def at(ts: np.ndarray) -> Stick:
+            w, b, c = (np.stack([np.interp(ts, t, p[:, k]) for k in range(3)], 1) for p in stick)
+            return w, b, c
+
+        return at
+
+    impacts = [[-1.0, 2.0], [-1.0, 0.5, 2.0] if right_busy else [-1.0, 2.0]]
+    moves, _lifts = detours([of(left), of(right)], impacts, GEOMETRY.kit, (0.0, 1.0), -np.inf)
+    assert [len(m) for m in moves] == ([1, 0] if right_busy else [1, 1])
+    la = [c + offsets(moves[0], t) for c in left[1:]]
+    ra = [c + offsets(moves[1], t) for c in right[1:]]
+    between = offsets(moves[0], np.array([0.5])) - offsets(moves[1], np.array([0.5]))
+    assert float(np.linalg.norm(between)) > max(UP_M)
+    pa, pb = segment_closest(la[0], la[1], ra[0], ra[1])
+    assert np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M - 1e-9
+
+
 def _report(path: Path, seconds: float, live: bool = False) -> dict[str, object]:
     out = StringIO()
     argv = ["motion-report", str(path), "--max-seconds", f"{seconds:g}", "--json"]
@@ -207,6 +245,22 @@ def test_a_left_stick_coming_down_through_the_crossed_right_one_goes_past_its_ti
     has 65 ms to its stroke; on main 34d9a8b: stick-stick 2.  The right hand now moves
     out along the left stick, past its tip."""
     _meets_targets(_report(GMD / "drummer3_session2_31_hiphop_92_beat_4-4.mid", 4.0, False))
+
+
+@pytest.mark.parametrize("live", [False, True])
+def test_a_left_tom_stroke_under_the_crossed_right_stick_makes_both_hands_give_way(
+    live: bool,
+) -> None:
+    """GMD rock half-time 140 fill (drummer1 session1 take 215, 10 notes, 0.9 s): the
+    right hand strikes the hi-hat (0.430 s) crossed over the left, which rises from
+    the snare (0.225 s) for a loud stroke on the high tom (0.639 s): its stick goes up
+    through the right one as the right lands (0.43-0.46 s), and its hand comes back
+    down through it 26-35 ms before its own stroke (0.60-0.61 s).  Neither hand alone
+    has the time (the right lands inside the first, the left's stroke follows the
+    second); on main 6e92c30 stick-stick 2, whole input and as live.  Now both give
+    way: the left stays under (4.2 cm down), the right over (4.2 cm up)."""
+    name = "drummer1_session1_215_rock-halftime_140_fill_4-4.mid"
+    _meets_targets(_report(GMD / name, 2.0, live))
 
 
 def _meets_targets(fig: dict[str, object]) -> None:

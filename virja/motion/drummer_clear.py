@@ -14,9 +14,13 @@ impact of that hand, ramps in and out with smoothstep and holds over the conflic
   hand moves: across the sticks to ``STICK_CLEAR_M``, or up over the other stick,
   or back along its own, or out along the other stick past its tip (a stick passing
   upright through the other one, the left coming down from the crash to the snare
-  through the crossed right stick: no offset across or up fits); the least offset that fits between that hand's impacts,
+  through the crossed right stick: no offset across or up fits), as far as it takes
+  to bring one stick's tip around the other's (``_END_PAST_M``); the least offset
+  that fits between that hand's impacts,
   keeps the sticks ``STICK_APART_M`` apart over its whole window, puts no tip
   into a piece and adds no 30 fps jump over ``JUMP_OK_M`` (:func:`_apart_detour`);
+  where no one hand's fits within a ramp of ``RAMP_MAX_S``, both hands move, each
+  half of one of those offsets, and only then one hand on a longer ramp;
 - **tip against a piece**: the stick turns up about the wrist (a *lift* detour, the
   wrist stays where it is) until the tip is ``SURFACE_CLEAR_M`` over the surface:
   over the rim, not through the cymbal.  (Moving the whole hand up instead added up
@@ -48,6 +52,15 @@ STICK_CLEAR_M = 0.035
 # if the least offset does not, one STICK_MORE_M larger is tried
 STICK_APART_M = 0.018
 STICK_MORE_M = 0.02
+# ... and where a stick passes through the other one from under to over (or over to
+# under: the left rising from the snare to the crash, or coming down from it, through the
+# right stick lying crossed over the hi-hat), no offset across or up can hold them apart
+# (a bump only moves the crossing in time); one stick is taken around the other's end:
+# its hand pulled back along its own stick until its tip is this far behind the
+# crossing, or moved along the other stick until that one's tip is (GMD sample from
+# offset 8, round 9: all 8 stick-stick runs left were such passes, the tip 12-17 cm
+# past the other stick, more than UP_M's largest)
+_END_PAST_M = 0.03
 # a hand lifted over the other stick, or pulled back along its own stick out of the
 # other's way, when across them fails (GMD hiphop 110: stick-stick 4 -> 3 with these);
 # the last is about the most a ramp allows (RAMP_SPEED_M_S x RAMP_MAX_S / 1.5 = 16 cm):
@@ -64,7 +77,10 @@ RIM_MARGIN_M = 0.01
 # (the downstroke lands exactly where it was planned)
 AFTER_IMPACT_S = 0.006
 BEFORE_IMPACT_S = 0.03
-RAMP_MAX_S = 0.08  # ramps no longer than this (a detour is local)
+# ramps no longer than this (a detour is local), unless its amplitude needs a longer one
+# at RAMP_SPEED_M_S (_END_PAST_M, 16-20 cm: 80-100 ms), as local as its speed allows,
+# and tried after both hands sharing the offset (_apart_detour)
+RAMP_MAX_S = 0.08
 # a move detour holds this much longer on either side of its conflict, where it fits
 # (the least that keeps the sticks apart over the whole window): the sticks move on,
 # and held over the conflict alone the crossing came back just after it (GMD hiphop
@@ -160,26 +176,26 @@ def _apart_over(
     t: np.ndarray,
     a: Stick,
     b: Stick,
-    h: int,
-    w: Window,
-    vec: np.ndarray,
+    moved: Sequence[tuple[int, Window, np.ndarray]],
     run: tuple[int, int],
 ) -> bool:
-    """Whether hand ``h`` moved by a detour (window ``w``, offset ``vec``) keeps the two
+    """Whether the hands moved by detours ``moved`` (hand, window, offset) keep the two
     sticks (``a`` left, ``b`` right, sampled at ``t``) at least STICK_APART_M apart over
     the whole window and the conflict's samples ``run`` (a detour found on the nearest
     sample alone could push the crossing a few ms on, or push the stick through the
     other one; one squeezed before its hand's impact could end before the conflict
     begins and leave it as it was: GMD hiphop 110 at 6.27 s, a right-hand detour over
     6.14-6.25 s for sticks crossing at 6.26-6.27 s, 10 ms before its hi-hat stroke)."""
-    i = min(int(np.searchsorted(t, w[0])), run[0])
-    j = max(int(np.searchsorted(t, w[3], side="right")), run[1] + 1)
+    i = min([int(np.searchsorted(t, w[0])) for _h, w, _v in moved] + [run[0]])
+    j = max([int(np.searchsorted(t, w[3], side="right")) for _h, w, _v in moved] + [run[1] + 1])
     if j <= i:
         return True
-    off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
-    sa = [p[i:j] + (off if h == 0 else 0.0) for p in a[1:]]
-    sb = [p[i:j] + (off if h == 1 else 0.0) for p in b[1:]]
-    pa, pb = segment_closest(sa[0], sa[1], sb[0], sb[1])
+    sides = [[p[i:j] for p in s[1:]] for s in (a, b)]
+    for h, w, vec in moved:
+        off = offsets([Detour(w[0], w[1], w[2], w[3], vec)], t[i:j])
+        sides[h] = [p + off for p in sides[h]]
+    (a0, a1), (b0, b1) = sides
+    pa, pb = segment_closest(a0, a1, b0, b1)
     return bool(np.linalg.norm(pa - pb, axis=1).min() >= STICK_APART_M)
 
 
@@ -216,8 +232,9 @@ def _window(
         t1 = t2 = min(max(mid, lo + need), hi - need)
         if lo + need > hi - need:
             return None
-    ramp_in = min(RAMP_MAX_S, t1 - lo)
-    ramp_out = min(RAMP_MAX_S, hi - t2)
+    longest = max(RAMP_MAX_S, need)  # see RAMP_MAX_S
+    ramp_in = min(longest, t1 - lo)
+    ramp_out = min(longest, hi - t2)
     # a ramp clamped to the least it may be (t1 = lo + need) comes back from the
     # subtraction an ulp short of ``need``: compared exactly, such a detour was never
     # made (as live, MMA Swing1 at 240 bpm at 10.68 s: the left tip 66 mm under the
@@ -293,6 +310,12 @@ def _harmless(
     return jn <= max(jo, JUMP_OK_M) and sn <= max(so, SPEED_OK_M_S)
 
 
+def _to_tip(point: np.ndarray, tip: np.ndarray, back: np.ndarray) -> float:
+    """How far (m) ``tip`` (3,) lies ahead of ``point`` (3,) against the horizontal
+    direction ``back`` (unit, (3,)): the stick's length to pull back past a crossing."""
+    return max(float((point - tip) @ back), 0.0)
+
+
 def _apart_detour(
     t: np.ndarray,
     both: tuple[Stick, Stick],
@@ -301,8 +324,8 @@ def _apart_detour(
     impacts: Sequence[Sequence[float]],
     kit: DrumKit,
     floor: float,
-) -> tuple[int, Detour] | None:
-    """(hand, detour) keeping the two sticks apart over the samples ``run`` where they
+) -> list[tuple[int, Detour]] | None:
+    """[(hand, detour)] keeping the two sticks apart over the samples ``run`` where they
     come near (``gap``: left minus right closest points), or None.
 
     Tried in order of the offset's size, the higher first, then the hand with more
@@ -310,9 +333,13 @@ def _apart_detour(
     side it comes from, or on the side it goes to), then one hand up, over the other
     stick, pulled back along its own stick, or moved out along the other stick, past
     its tip (GMD hip-hop 92 at 3.16-3.19 s: the left stick coming down to the snare
-    through the crossed right one, 65 ms before its stroke; the right moves); each held longer (HOLD_PAD_S) if it
-    must.  The first that fits between the hand's impacts, keeps the sticks apart over
-    its whole window and harms nothing (:func:`_harmless`) is made."""
+    through the crossed right one, 65 ms before its stroke; the right moves), by the
+    amounts of UP_M and by as far as takes one tip around the other stick
+    (_END_PAST_M); each held longer (HOLD_PAD_S) if it must.  The first that fits
+    between the hand's impacts, keeps the sticks apart over its whole window and harms
+    nothing (:func:`_harmless`) is made, first among those one ramp of RAMP_MAX_S
+    takes (16 cm); if none, the same offsets (between the sticks) shared, half by each
+    hand (two detours); then one hand alone on a longer ramp."""
     a, b = both
     i, j = run
     n = _apart(a, b, gap, i, j)
@@ -327,27 +354,75 @@ def _apart_detour(
                 vec = (amp if h == 0 else -amp) * side * n
                 tries.append((amp, -vec[1], free[h], h, vec))
     k = i + int(np.argmin(np.linalg.norm(gap[i : j + 1], axis=1)))
-    for amp in UP_M:
-        for h, stick in enumerate(both):
+    near = segment_closest(a[1][k : k + 1], a[2][k : k + 1], b[1][k : k + 1], b[2][k : k + 1])
+    for h, stick in enumerate(both):
+        back = stick[1][k] - stick[2][k]
+        back[1] = 0.0
+        back = back / max(float(np.linalg.norm(back)), 1e-9)
+        past = both[1 - h][2][k] - both[1 - h][1][k]
+        past[1] = 0.0
+        past = past / max(float(np.linalg.norm(past)), 1e-9)
+        for amp in UP_M:
             tries.append((amp, -amp, free[h], h, np.array([0.0, amp, 0.0])))
-            back = stick[1][k] - stick[2][k]
-            back[1] = 0.0
-            back = back / max(float(np.linalg.norm(back)), 1e-9)
             tries.append((amp, 0.0, free[h], h, amp * back))
-            past = both[1 - h][2][k] - both[1 - h][1][k]
-            past[1] = 0.0
-            past = past / max(float(np.linalg.norm(past)), 1e-9)
+            tries.append((amp, 0.0, free[h], h, amp * past))
+        # around the end: pulled back until its own tip, or moved along the other
+        # stick until that one's tip, is behind the crossing (a stick passing through
+        # the other one from under to over: no offset across or up fits)
+        own = _to_tip(near[h][0], stick[2][k], back)
+        other = _to_tip(near[1 - h][0], both[1 - h][2][k], -past)
+        for amp in (own + _END_PAST_M, own + _END_PAST_M + STICK_MORE_M):
+            tries.append((amp, 0.0, free[h], h, amp * back))
+        for amp in (other + _END_PAST_M, other + _END_PAST_M + STICK_MORE_M):
             tries.append((amp, 0.0, free[h], h, amp * past))
     tries.sort(key=lambda x: x[:3])
-    for pad in HOLD_PAD_S:
-        for amp, _up, _free_s, h, vec in tries:
-            w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
-            if (
-                w is not None
-                and _apart_over(t, a, b, h, w, vec, run)
-                and _harmless(t, both[h], w, vec, kit)
-            ):
-                return h, Detour(w[0], w[1], w[2], w[3], vec)
+
+    # a longer hold (HOLD_PAD_S) often gives the same window (held up to an impact):
+    # such a try is not checked again (its checks are pure; it failed)
+    seen: set[tuple[tuple[int, Window, bytes], ...]] = set()
+
+    def fits(moved: list[tuple[int, Window, np.ndarray]]) -> bool:
+        key = tuple((h, w, v.tobytes()) for h, w, v in moved)
+        if key in seen:
+            return False
+        seen.add(key)
+        return _apart_over(t, a, b, moved, run) and all(
+            _harmless(t, both[h], w, v, kit) for h, w, v in moved
+        )
+
+    def alone(longer: bool) -> list[tuple[int, Detour]] | None:
+        for pad in HOLD_PAD_S:
+            for amp, _up, _free_s, h, vec in tries:
+                if (1.5 * amp / RAMP_SPEED_M_S > RAMP_MAX_S + _TIME_EPS_S) != longer:
+                    continue
+                w = _window(impacts[h], t_in, t_out, floor, amp, pad=pad)
+                if w is not None and fits([(h, w, vec)]):
+                    return [(h, Detour(w[0], w[1], w[2], w[3], vec))]
+        return None
+
+    def shared() -> list[tuple[int, Detour]] | None:
+        for pad in HOLD_PAD_S:
+            for amp, _up, _free_s, h, vec in tries:
+                half = 0.5 * (vec if h == 0 else -vec)
+                moved = []
+                for g, v in ((0, half), (1, -half)):
+                    w = _window(impacts[g], t_in, t_out, floor, 0.5 * amp, pad=pad)
+                    if w is None:
+                        break
+                    moved.append((g, w, v))
+                else:
+                    if fits(moved):
+                        return [(g, Detour(w[0], w[1], w[2], w[3], v)) for g, w, v in moved]
+        return None
+
+    # one hand alone as far as a ramp of RAMP_MAX_S takes it (16 cm); then both hands
+    # give way, each half the offset between the sticks (the left's minus the
+    # right's), each ramp half as long (GMD rock half-time 140 fill at 0.43 and 0.61 s:
+    # a left tom stroke from under the right stick crossed over the hi-hat, the right
+    # landing inside the first crossing, the left's stroke 26 ms after the second); and
+    # only then one hand alone on a longer ramp (a 16-20 cm pull-back alone, where both
+    # could, doubled the fill's wrist p99 as live: 1.7 -> 3.2 m/s, its jump 6 -> 13 cm)
+    return alone(False) or shared() or alone(True)
     return None
 
 
@@ -429,8 +504,8 @@ def detours_in(
         for i, j in _runs(d < STICK_CLEAR_M):
             if d[i : j + 1].min() < STICK_TRIGGER_M:
                 found = _apart_detour(t, (left, right), gap, (i, j), impacts, sampled.kit, floor)
-                if found is not None:
-                    out[found[0]].append(found[1])
+                for h, made in found or ():
+                    out[h].append(made)
     for h, heights in enumerate(sampled.heights):
         for hgt, inside in heights:
             for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):

@@ -51,6 +51,23 @@ def test_a_flam_is_two_hands_each_at_its_own_time() -> None:
     assert {p.limb for p in planned} == {"left_hand", "right_hand"}
 
 
+def test_a_double_on_a_cymbal_is_one_hands_and_a_flam_on_a_drum_two() -> None:
+    """Round 9: two ride notes 29 ms apart (GMD rock 102 records every stroke twice) were
+    a flam of both hands, the left crossing to the ride under the right stick (they
+    touched); on a cymbal it is one hand's double, on the snare still a flam."""
+    ride, report = _plan([(0.5, 51, 80), (1.0, 51, 77), (1.029, 51, 70), (1.25, 38, 90)])
+    _all_played_on_time(ride, report, 4)
+    assert [p.limb for p in sorted(ride, key=lambda p: p.time)] == [
+        "right_hand",
+        "right_hand",
+        "right_hand",
+        "left_hand",
+    ]
+    snare, report = _plan([(1.0, 38, 40), (1.025, 38, 100)])
+    _all_played_on_time(snare, report, 2)
+    assert {p.limb for p in snare} == {"left_hand", "right_hand"}
+
+
 def test_humanised_hits_meant_together_are_grouped_and_keep_their_times() -> None:
     """Snare and ride 2-30 ms apart used to be two groups, the hands planned apart."""
     notes = []

@@ -330,3 +330,27 @@ def test_hand_speed_table_errors() -> None:
     ):
         with pytest.raises(ConfigError, match="hand_speed"):
             parse_timing({**data, "hand_speed": bad})
+
+
+def test_hand_stretch_one_hand_doubles_are_hand_pieces_at_most_a_stretch() -> None:
+    from virja import tomlconf
+    from virja.errors import ConfigError
+    from virja.plan.config import parse_timing
+    from virja.resources import motions_file
+
+    path = motions_file("timing.toml", None)
+    assert path is not None
+    data = tomlconf.read(path)
+    timing = parse_timing(data)
+    assert timing.one_hand_doubles == {"hihat", "ride", "crash", "crash2"}
+    assert timing.one_hand_double_penalty == 0.0
+    stretch = data["hand_stretch"]
+    for bad in (
+        {"one_hand_doubles": ["ride", "cowbell"]},
+        {"one_hand_double_penalty": -1.0},
+        {"one_hand_double_penalty": stretch["penalty"] + 1},
+    ):
+        with pytest.raises(ConfigError, match="hand_stretch"):
+            parse_timing({**data, "hand_stretch": {**stretch, **bad}})
+    plain = {k: v for k, v in stretch.items() if not k.startswith("one_hand")}
+    assert parse_timing({**data, "hand_stretch": plain}).one_hand_doubles == frozenset()

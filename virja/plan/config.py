@@ -201,6 +201,10 @@ class Timing:
     stretch_interval_s: float | None = None
     stretch_moves: dict[tuple[str, str], float] = field(default_factory=dict)
     stretch_penalty: float = 0.0
+    # two notes of one of these pieces in one group are one hand's double (the second on
+    # its rebound) at ``one_hand_double_penalty`` rather than ``stretch_penalty``
+    one_hand_doubles: frozenset[str] = frozenset()
+    one_hand_double_penalty: float = 0.0
     # the hand's speed (timing.toml [hand_speed]): a stroke on another piece than the
     # hand's last costs the penalty of the fastest tier ``(speed_m_s, penalty)`` whose
     # speed the move needs (``distances[(prev, piece)]`` / time since the last stroke)
@@ -353,6 +357,8 @@ class HandStretchTable(Schema):
     base_s: float
     speed_m_s: float
     penalty: float
+    one_hand_doubles: list[str] = []
+    one_hand_double_penalty: float = 0.0
 
 
 class HandSpeedTable(Schema):
@@ -499,16 +505,26 @@ def parse_timing(data: dict[str, Any], *, where: str = "timing.toml") -> Timing:
         moves = hand_moves(base_s, speed)
     timing = Timing(60.0 / f.reference_bpm, f.rest_s, kinds, moves)
     if (st := f.hand_stretch) is not None:
-        if st.min_interval_s < 0 or st.base_s < 0 or st.speed_m_s <= 0 or st.penalty < 0:
+        if (
+            st.min_interval_s < 0
+            or st.base_s < 0
+            or st.speed_m_s <= 0
+            or st.penalty < 0
+            or not 0 <= st.one_hand_double_penalty <= st.penalty
+            or not set(st.one_hand_doubles) <= set(HAND_PIECES)
+        ):
             raise ConfigError(
                 f"{where}: hand_stretch needs min_interval_s >= 0, base_s >= 0, "
-                "speed_m_s > 0 and penalty >= 0"
+                "speed_m_s > 0, penalty >= 0, 0 <= one_hand_double_penalty <= penalty "
+                f"and one_hand_doubles among the hand pieces {sorted(HAND_PIECES)}"
             )
         timing = dataclasses.replace(
             timing,
             stretch_interval_s=st.min_interval_s,
             stretch_moves=hand_moves(st.base_s, st.speed_m_s),
             stretch_penalty=st.penalty,
+            one_hand_doubles=frozenset(st.one_hand_doubles),
+            one_hand_double_penalty=st.one_hand_double_penalty,
         )
     if (sp := f.hand_speed) is not None:
         speeds, pens = sp.speeds_m_s, sp.penalties

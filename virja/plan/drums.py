@@ -100,7 +100,8 @@ def unplayed_penalty(
 ) -> float:
     """What leaving stroke ``i`` to no hand of its own costs: a flam or drag (two strokes
     of one piece) played by one hand, the second note on the stroke's rebound, is that
-    hand at a stretch (``stretch_penalty``, when the timing has a stretch), and so is
+    hand at a stretch (``stretch_penalty``, when the timing has a stretch; on a cymbal
+    of ``Timing.one_hand_doubles`` a double, ``one_hand_double_penalty``), and so is
     a hi-hat stroke the left foot takes (``Stroke.foot``); any other stroke is
     dropped (:func:`drop_penalty`)."""
     if timing.stretch_interval_s is not None:
@@ -112,6 +113,8 @@ def unplayed_penalty(
             and assign[other] is not None
             and strokes[other].piece == strokes[i].piece
         ):
+            if strokes[i].piece in timing.one_hand_doubles:  # a cymbal's double
+                return timing.one_hand_double_penalty
             return timing.stretch_penalty
     return drop_penalty(costs, strokes[i])
 

@@ -423,7 +423,6 @@ def _apart_detour(
     # only then one hand alone on a longer ramp (a 16-20 cm pull-back alone, where both
     # could, doubled the fill's wrist p99 as live: 1.7 -> 3.2 m/s, its jump 6 -> 13 cm)
     return alone(False) or shared() or alone(True)
-    return None
 
 
 class Sampled:

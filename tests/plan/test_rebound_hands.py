@@ -134,3 +134,17 @@ def test_a_note_no_hand_reaches_at_a_drummers_speed_is_a_physical_limit() -> Non
     crash = next(p for p in planned if p.note == 55 and p.velocity == 87)
     assert (crash.limb, ride.limb) == (LEFT, RIGHT)
     assert _too_soon(planned) == []
+
+
+def test_a_ride_double_split_by_the_grouping_window_is_one_hands() -> None:
+    """GMD rock 102 at 5.62 s (a take whose every stroke is recorded twice): two ride
+    notes 19 ms apart fell into two groups and went to both hands, the left crossing to
+    the ride onto the right stick (a stick-stick run).  On a cymbal a double within the
+    grouping window is one hand's, split by the window or not."""
+    planned, report, _notes = _plan("drummer2_session1_2_rock_102_beat_4-4_ride")
+    assert report.dropped == ()
+    pair = sorted(
+        (p for p in planned if p.piece == "ride" and 2.1 < p.time < 2.15), key=lambda p: p.time
+    )
+    assert [round(p.time, 3) for p in pair] == [2.123, 2.142]
+    assert [p.limb for p in pair] == [RIGHT, RIGHT]

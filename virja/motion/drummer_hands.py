@@ -105,6 +105,8 @@ _REACH_MIN_S = 0.04
 # a stroke whose piece lies this far from where the hand is moves the hand toward it
 # (DrummerHands.departs); nearer, only the stick's backswing shows it (the hand stays)
 _DEPART_M = 0.02
+# a hand raised over the other stick at an impact (DrummerHands._over) in steps of this
+_OVER_STEP_M = 0.005
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
 
 
@@ -199,6 +201,12 @@ class _Base:
 def _tip(row: np.ndarray) -> np.ndarray:
     """The stick's tip of a (grip, rot, ...) row."""
     return np.asarray(row[:3] + STICK_TIP_M * quat.rotate(row[3:7], STICK_AXIS_LOCAL))
+
+
+def _stick_ends(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The stick's butt and tip of a (grip, rot, ...) row."""
+    axis = quat.rotate(row[3:7], STICK_AXIS_LOCAL)
+    return row[:3] - STICK_BUTT_M * axis, row[:3] + STICK_TIP_M * axis
 
 
 def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
@@ -595,6 +603,48 @@ class DrummerHands:
             return out if t_o - cut >= _YIELD_MIN_S else None
         return None
 
+    def _over(self, hand: str, t: float, row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of ``hand``'s stroke at ``t``) with the hand raised
+        over the other stick, turned about its tip, where the other hand strikes within
+        ``drummer_clear.BEFORE_IMPACT_S`` with its stick (at its impact) crossing this
+        one under ``STICK_TRIGGER_M``: there neither track may be bent (the detours
+        are zero that near an impact), so the two impact poses themselves must lie
+        apart.  Of the two, the stick higher where they cross goes over: its hand
+        rises until ``STICK_CLEAR_M`` lies between them, at most ``reach_max_m`` (the
+        left on the high tom 13 ms before the right, crossed over it, on the hi-hat:
+        GMD neworleans-funk 84 fill at 0.03 s, the sticks 1 mm apart at both impacts)."""
+        other = HANDS[1 - HANDS.index(hand)]
+        times = self._times[other]
+        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
+        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
+        _start, _pose, vel, art = self._strokes[hand][bisect.bisect_left(self._times[hand], t)]
+        lift = self._lift_for(vel, math.inf, art)
+        for j in range(lo, hi):
+            _s, pose_o, vel_o, art_o = self._strokes[other][j]
+            lift_o = self._lift_for(vel_o, math.inf, art_o)
+            b0, b1 = _stick_ends(np.concatenate([pose_o.grip, pose_o.rot]))
+            a0, a1 = _stick_ends(row)
+            pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
+            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_TRIGGER_M:
+                continue
+            # the same pair seen from the other hand's build: one of them goes over
+            if abs(lift - lift_o) > 1e-9:
+                if lift < lift_o:
+                    continue
+            elif abs(float(pa[0, 1] - pb[0, 1])) > 1e-9:
+                if pa[0, 1] < pb[0, 1]:
+                    continue
+            elif hand != HANDS[1]:
+                continue
+            wrist = self._wrist(hand, row)
+            for k in range(1, 1 + int(self.settings.reach_max_m / _OVER_STEP_M + 1e-9)):
+                up = self._reach(hand, row, wrist + _UP, k * _OVER_STEP_M)
+                a0, a1 = _stick_ends(up)
+                pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
+                if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
+                    return up
+        return row
+
     def _wrist(self, hand: str, row: np.ndarray) -> np.ndarray:
         """The wrist of a (grip, rot, elbow) row."""
         return np.asarray(row[:3] - quat.rotate(row[3:7], self._grip_off[hand]))
@@ -725,7 +775,7 @@ class DrummerHands:
         for i, (t, (start, pose, vel, art)) in enumerate(zip(times, strokes, strict=True)):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
-            target = np.concatenate([pose.grip, pose.rot, pose.elbow])
+            target = self._over(hand, t, np.concatenate([pose.grip, pose.rot, pose.elbow]))
             if base is not None:
                 start = max(start, floor)
             if prev_t is None and base is None:

@@ -62,6 +62,7 @@ _SK = SKELETON
 HANDS = ("left_hand", "right_hand")
 _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
+_FLAT = np.array([1.0, 0.0, 1.0])  # seen from above
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
 _MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
 _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
@@ -98,6 +99,13 @@ _SQUEEZED, _RAMP = 4, 0.2
 # (a turn about the tip moves the wrist square to the stick): 15.7 -> 14.4 cm a frame
 _SQUEEZED_FAST, _RAMP_FAST, _FAST_M_S = 6, 0.1, 3.4
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
+# ... a squeezed move up to a stroke that ends crossed over the other hand's stick (the
+# other strikes within drummer_clear.BEFORE_IMPACT_S, its stick under this one where
+# they cross seen from above) gets its height first, as the mirror of a move off the
+# hi-hat keeping it late (_HIHAT_LAG), then goes across: the right rising from the
+# snare straight to the hi-hat swept through the left stick coming down from it to the
+# snare (GMD latin 84 at 0.86 s: both strokes 5 ms apart, no detour fits so near them)
+_SQUEEZED_OVER, _OVER_LEAD = 7, _HIHAT_LAG
 _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
@@ -255,7 +263,7 @@ def _shaped(
             prof == _DECEL,
             1.0 - (1.0 - u) ** 2,
             np.where(
-                prof == _SQUEEZED,
+                (prof == _SQUEEZED) | (prof == _SQUEEZED_OVER),
                 _ramped(u),
                 np.where(prof == _SQUEEZED_FAST, _ramped(u, _RAMP_FAST), u * u * (3 - 2 * u)),
             ),
@@ -287,7 +295,7 @@ def _shape(u: float, profile: int) -> float:
         return u * u
     if profile == _DECEL:
         return 1.0 - (1.0 - u) ** 2
-    if profile == _SQUEEZED:
+    if profile in (_SQUEEZED, _SQUEEZED_OVER):
         return float(_ramped(np.asarray(u)))
     if profile == _SQUEEZED_FAST:
         return float(_ramped(np.asarray(u), _RAMP_FAST))
@@ -298,14 +306,20 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
     """How far along its move the grip's height is at shaped fraction ``u``: a hand going
     down stays up until late (off a cymbal over its edge, not under it); on a move
     given its full time (:data:`_MOVE`) a hand going up also rises first, on a
-    squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first;
-    all start and end at rest."""
+    squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first, one
+    that ends crossed over the other stick (:data:`_SQUEEZED_OVER`) first; all start
+    and end at rest."""
     moving = (profile == _MOVE) | (profile == _MOVE_OFF_HIHAT)
-    squeezed = (profile == _SQUEEZED) | (profile == _SQUEEZED_FAST)
+    over = profile == _SQUEEZED_OVER
+    squeezed = (profile == _SQUEEZED) | (profile == _SQUEEZED_FAST) | over
     lead = np.where(
         moving,
         1.0 - (1.0 - u) ** _RISE_LEAD,
-        np.where(squeezed, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        np.where(
+            over,
+            1.0 - (1.0 - u) ** _OVER_LEAD,
+            np.where(squeezed, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        ),
     )
     lag = np.where(
         profile == _MOVE_OFF_HIHAT,
@@ -645,6 +659,26 @@ class DrummerHands:
                     return up
         return row
 
+    def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
+        """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
+        other hand's stick, crossed seen from above (under ``STICK_CLEAR_M``), at an
+        impact of the other within ``drummer_clear.BEFORE_IMPACT_S``."""
+        other = HANDS[1 - HANDS.index(hand)]
+        times = self._times[other]
+        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
+        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
+        a0, a1 = (e[None] for e in _stick_ends(row))
+        for j in range(lo, hi):
+            pose_o = self._strokes[other][j][1]
+            b0, b1 = (e[None] for e in _stick_ends(np.concatenate([pose_o.grip, pose_o.rot])))
+            pa, pb = drummer_clear.segment_closest(a0 * _FLAT, a1 * _FLAT, b0 * _FLAT, b1 * _FLAT)
+            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
+                continue
+            pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
+            if pa[0, 1] > pb[0, 1]:
+                return True
+        return False
+
     def _wrist(self, hand: str, row: np.ndarray) -> np.ndarray:
         """The wrist of a (grip, rot, elbow) row."""
         return np.asarray(row[:3] - quat.rotate(row[3:7], self._grip_off[hand]))
@@ -826,7 +860,14 @@ class DrummerHands:
                 off_hihat = prev_piece == "hihat"
                 _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
-                _add(pt, pv, pp, t, target, _squeezed(float(way), t - cut))
+                shape = _squeezed(float(way), t - cut)
+                if (
+                    shape == _SQUEEZED
+                    and target[1] > here[1]
+                    and self._crosses_over(hand, t, target)
+                ):
+                    shape = _SQUEEZED_OVER
+                _add(pt, pv, pp, t, target, shape)
             if reached is not target:  # known on the way: re-aimed from then
                 assert j is not None
                 _cut(pt, pv, pp, strokes[j][0], _pose_at)

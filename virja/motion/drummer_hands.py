@@ -106,6 +106,10 @@ _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymb
 # snare straight to the hi-hat swept through the left stick coming down from it to the
 # snare (GMD latin 84 at 0.86 s: both strokes 5 ms apart, no detour fits so near them)
 _SQUEEZED_OVER, _OVER_LEAD = 7, _HIHAT_LAG
+# ... where that keeps the grip's peak speed within a squeezed move's at _FAST_M_S
+# (1.25 x 3.4 = 4.25 m/s): the right rising 41 cm from the snare to the crash in 203 ms
+# over the left's snare stroke (GMD soul-motown 148 at 6.3 s) jumped 16.6 cm a frame
+_OVER_PEAK_M_S = _FAST_M_S / (1.0 - _RAMP)
 _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
@@ -288,6 +292,17 @@ def _squeezed(way_m: float, span_s: float) -> int:
     """The profile of a move of ``way_m`` (grip) squeezed into ``span_s``:
     :data:`_SQUEEZED_FAST` over ``_FAST_M_S`` on average, else :data:`_SQUEEZED`."""
     return _SQUEEZED_FAST if way_m > _FAST_M_S * max(span_s, 1e-9) else _SQUEEZED
+
+
+def _over_peak_m_s(a: np.ndarray, b: np.ndarray, span_s: float) -> float:
+    """The grip's peak speed (m/s) on a :data:`_SQUEEZED_OVER` move from ``a`` up to ``b``
+    (grip positions) in ``span_s``."""
+    u = _ramped(np.linspace(0.0, 1.0, 201))
+    h = _height_share(u, np.full(u.shape, b[1] - a[1]), np.full(u.shape, _SQUEEZED_OVER))
+    path = a + u[:, None] * (b - a)
+    path[:, 1] = a[1] + h * (b[1] - a[1])
+    step = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    return float(step.max() * 200 / max(span_s, 1e-9))
 
 
 def _shape(u: float, profile: int) -> float:
@@ -864,6 +879,7 @@ class DrummerHands:
                 if (
                     shape == _SQUEEZED
                     and target[1] > here[1]
+                    and _over_peak_m_s(here[:3], target[:3], t - cut) <= _OVER_PEAK_M_S
                     and self._crosses_over(hand, t, target)
                 ):
                     shape = _SQUEEZED_OVER

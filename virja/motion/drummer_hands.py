@@ -29,6 +29,10 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **profiles**: into an impact the stick accelerates (u^2), out of it it
   decelerates, every other segment eases in and out (smoothstep); the pose
   is interpolated between keys (grip and elbow lerp, hand rotation slerp).
+- **crossed at once**: where the two hands strike within ``BEFORE_IMPACT_S`` of each
+  other (no detour bends a track there), the louder stroke's hand lands raised over
+  the other stick (:meth:`DrummerHands._over`), and a squeezed move up to a stroke
+  that ends crossed over the other stick gets its height first (``_SQUEEZED_OVER``).
 - **apart**: the two hands' tracks are sampled together and bent around each
   other and the kit where a stick would go through the other or a tip under a
   piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).

@@ -263,6 +263,29 @@ def test_a_left_tom_stroke_under_the_crossed_right_stick_makes_both_hands_give_w
     _meets_targets(_report(GMD / name, 2.0, live))
 
 
+@pytest.mark.parametrize("live", [False, True])
+def test_two_strokes_at_once_with_the_sticks_crossed_put_the_louder_over(live: bool) -> None:
+    """GMD New Orleans funk 84 fill (drummer1 session1 take 92, 16 notes, 1.4 s): from
+    the ready pose the left hand strikes the high tom (0.030 s, velocity 114) and the
+    right, crossed over it, the hi-hat (0.043 s, velocity 15).  Both strokes lie inside
+    each other's 30 ms before an impact, where no detour may bend a track, and their
+    impact poses cross 1 mm apart: on main 7466561 stick-stick 1 (0.013-0.042 s), whole
+    input and as live.  The louder stroke's hand (the higher backswing) now lands
+    raised over the other stick, its stick turned about its tip."""
+    name = "drummer1_session1_92_neworleans-funk_84_fill_4-4.mid"
+    _meets_targets(_report(GMD / name, 2.0, live))
+
+
+def test_a_hand_crossing_over_the_other_to_the_hihat_rises_before_it_crosses() -> None:
+    """GMD latin 84 (drummer8 session2 take 25), first 2 s: the hands swap hi-hat and
+    snare in 180 ms, the right from the snare (0.720 s) to the hi-hat (0.906 s) crossed
+    over the left, which comes down from the hi-hat (0.729 s) to a loud snare stroke
+    (0.911 s).  On a straight squeezed move the right stick swept up through the left
+    one 45-50 ms before both strokes, where the best detour kept them 12.7 mm apart: on
+    main 7466561 stick-stick 1 (0.858-0.862 s).  The right now gets its height first."""
+    _meets_targets(_report(GMD / "drummer8_session2_25_latin_84_beat_4-4.mid", 2.0))
+
+
 def _meets_targets(fig: dict[str, object]) -> None:
     collisions = fig["collisions"]
     assert isinstance(collisions, dict)

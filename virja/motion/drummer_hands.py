@@ -29,6 +29,10 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
 - **profiles**: into an impact the stick accelerates (u^2), out of it it
   decelerates, every other segment eases in and out (smoothstep); the pose
   is interpolated between keys (grip and elbow lerp, hand rotation slerp).
+- **crossed at once**: where the two hands strike within ``BEFORE_IMPACT_S`` of each
+  other (no detour bends a track there), the louder stroke's hand lands raised over
+  the other stick (:meth:`DrummerHands._over`), and a squeezed move up to a stroke
+  that ends crossed over the other stick gets its height first (``_SQUEEZED_OVER``).
 - **apart**: the two hands' tracks are sampled together and bent around each
   other and the kit where a stick would go through the other or a tip under a
   piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).
@@ -62,6 +66,7 @@ _SK = SKELETON
 HANDS = ("left_hand", "right_hand")
 _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
+_FLAT = np.array([1.0, 0.0, 1.0])  # seen from above
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
 _MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
 _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
@@ -98,6 +103,17 @@ _SQUEEZED, _RAMP = 4, 0.2
 # (a turn about the tip moves the wrist square to the stick): 15.7 -> 14.4 cm a frame
 _SQUEEZED_FAST, _RAMP_FAST, _FAST_M_S = 6, 0.1, 3.4
 _SQUEEZED_LEAD = 1.1  # its rise leads a little (_height_share), clear of a cymbal's edge
+# ... a squeezed move up to a stroke that ends crossed over the other hand's stick (the
+# other strikes within drummer_clear.BEFORE_IMPACT_S, its stick under this one where
+# they cross seen from above) gets its height first, as the mirror of a move off the
+# hi-hat keeping it late (_HIHAT_LAG), then goes across: the right rising from the
+# snare straight to the hi-hat swept through the left stick coming down from it to the
+# snare (GMD latin 84 at 0.86 s: both strokes 5 ms apart, no detour fits so near them)
+_SQUEEZED_OVER, _OVER_LEAD = 7, _HIHAT_LAG
+# ... where that keeps the grip's peak speed within a squeezed move's at _FAST_M_S
+# (1.25 x 3.4 = 4.25 m/s): the right rising 41 cm from the snare to the crash in 203 ms
+# over the left's snare stroke (GMD soul-motown 148 at 6.3 s) jumped 16.6 cm a frame
+_OVER_PEAK_M_S = _FAST_M_S / (1.0 - _RAMP)
 _SQUEEZED_LAG = 1.0
 # a hand re-aims its impact toward the next piece (HandSettings.reach_*) only when that
 # stroke is known at least this long before the impact
@@ -105,6 +121,8 @@ _REACH_MIN_S = 0.04
 # a stroke whose piece lies this far from where the hand is moves the hand toward it
 # (DrummerHands.departs); nearer, only the stick's backswing shows it (the hand stays)
 _DEPART_M = 0.02
+# a hand raised over the other stick at an impact (DrummerHands._over) in steps of this
+_OVER_STEP_M = 0.005
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
 
 
@@ -201,6 +219,12 @@ def _tip(row: np.ndarray) -> np.ndarray:
     return np.asarray(row[:3] + STICK_TIP_M * quat.rotate(row[3:7], STICK_AXIS_LOCAL))
 
 
+def _stick_ends(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The stick's butt and tip of a (grip, rot, ...) row."""
+    axis = quat.rotate(row[3:7], STICK_AXIS_LOCAL)
+    return row[:3] - STICK_BUTT_M * axis, row[:3] + STICK_TIP_M * axis
+
+
 def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
     """Whether two key tracks give the same poses at every time up to ``t``: the same
     keys up to ``t`` and the same segment across it."""
@@ -247,7 +271,7 @@ def _shaped(
             prof == _DECEL,
             1.0 - (1.0 - u) ** 2,
             np.where(
-                prof == _SQUEEZED,
+                (prof == _SQUEEZED) | (prof == _SQUEEZED_OVER),
                 _ramped(u),
                 np.where(prof == _SQUEEZED_FAST, _ramped(u, _RAMP_FAST), u * u * (3 - 2 * u)),
             ),
@@ -274,12 +298,23 @@ def _squeezed(way_m: float, span_s: float) -> int:
     return _SQUEEZED_FAST if way_m > _FAST_M_S * max(span_s, 1e-9) else _SQUEEZED
 
 
+def _over_peak_m_s(a: np.ndarray, b: np.ndarray, span_s: float) -> float:
+    """The grip's peak speed (m/s) on a :data:`_SQUEEZED_OVER` move from ``a`` up to ``b``
+    (grip positions) in ``span_s``."""
+    u = _ramped(np.linspace(0.0, 1.0, 201))
+    h = _height_share(u, np.full(u.shape, b[1] - a[1]), np.full(u.shape, _SQUEEZED_OVER))
+    path = a + u[:, None] * (b - a)
+    path[:, 1] = a[1] + h * (b[1] - a[1])
+    step = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    return float(step.max() * 200 / max(span_s, 1e-9))
+
+
 def _shape(u: float, profile: int) -> float:
     if profile == _ACCEL:
         return u * u
     if profile == _DECEL:
         return 1.0 - (1.0 - u) ** 2
-    if profile == _SQUEEZED:
+    if profile in (_SQUEEZED, _SQUEEZED_OVER):
         return float(_ramped(np.asarray(u)))
     if profile == _SQUEEZED_FAST:
         return float(_ramped(np.asarray(u), _RAMP_FAST))
@@ -290,14 +325,20 @@ def _height_share(u: np.ndarray, rise: np.ndarray, profile: np.ndarray) -> np.nd
     """How far along its move the grip's height is at shaped fraction ``u``: a hand going
     down stays up until late (off a cymbal over its edge, not under it); on a move
     given its full time (:data:`_MOVE`) a hand going up also rises first, on a
-    squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first;
-    all start and end at rest."""
+    squeezed one (:data:`_SQUEEZED`, already at its bounded speed) a little first, one
+    that ends crossed over the other stick (:data:`_SQUEEZED_OVER`) first; all start
+    and end at rest."""
     moving = (profile == _MOVE) | (profile == _MOVE_OFF_HIHAT)
-    squeezed = (profile == _SQUEEZED) | (profile == _SQUEEZED_FAST)
+    over = profile == _SQUEEZED_OVER
+    squeezed = (profile == _SQUEEZED) | (profile == _SQUEEZED_FAST) | over
     lead = np.where(
         moving,
         1.0 - (1.0 - u) ** _RISE_LEAD,
-        np.where(squeezed, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        np.where(
+            over,
+            1.0 - (1.0 - u) ** _OVER_LEAD,
+            np.where(squeezed, 1.0 - (1.0 - u) ** _SQUEEZED_LEAD, u),
+        ),
     )
     lag = np.where(
         profile == _MOVE_OFF_HIHAT,
@@ -595,6 +636,68 @@ class DrummerHands:
             return out if t_o - cut >= _YIELD_MIN_S else None
         return None
 
+    def _over(self, hand: str, t: float, row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of ``hand``'s stroke at ``t``) with the hand raised
+        over the other stick, turned about its tip, where the other hand strikes within
+        ``drummer_clear.BEFORE_IMPACT_S`` with its stick (at its impact) crossing this
+        one under ``STICK_TRIGGER_M``: there neither track may be bent (the detours
+        are zero that near an impact), so the two impact poses themselves must lie
+        apart.  Of the two, the stick higher where they cross goes over: its hand
+        rises until ``STICK_CLEAR_M`` lies between them, at most ``reach_max_m`` (the
+        left on the high tom 13 ms before the right, crossed over it, on the hi-hat:
+        GMD neworleans-funk 84 fill at 0.03 s, the sticks 1 mm apart at both impacts)."""
+        other = HANDS[1 - HANDS.index(hand)]
+        times = self._times[other]
+        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
+        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
+        _start, _pose, vel, art = self._strokes[hand][bisect.bisect_left(self._times[hand], t)]
+        lift = self._lift_for(vel, math.inf, art)
+        for j in range(lo, hi):
+            _s, pose_o, vel_o, art_o = self._strokes[other][j]
+            lift_o = self._lift_for(vel_o, math.inf, art_o)
+            b0, b1 = _stick_ends(np.concatenate([pose_o.grip, pose_o.rot]))
+            a0, a1 = _stick_ends(row)
+            pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
+            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_TRIGGER_M:
+                continue
+            # the same pair seen from the other hand's build: one of them goes over
+            if abs(lift - lift_o) > 1e-9:
+                if lift < lift_o:
+                    continue
+            elif abs(float(pa[0, 1] - pb[0, 1])) > 1e-9:
+                if pa[0, 1] < pb[0, 1]:
+                    continue
+            elif hand != HANDS[1]:
+                continue
+            wrist = self._wrist(hand, row)
+            for k in range(1, 1 + int(self.settings.reach_max_m / _OVER_STEP_M + 1e-9)):
+                up = self._reach(hand, row, wrist + _UP, k * _OVER_STEP_M)
+                a0, a1 = _stick_ends(up)
+                pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
+                if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
+                    return up
+        return row
+
+    def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
+        """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
+        other hand's stick, crossed seen from above (under ``STICK_CLEAR_M``), at an
+        impact of the other within ``drummer_clear.BEFORE_IMPACT_S``."""
+        other = HANDS[1 - HANDS.index(hand)]
+        times = self._times[other]
+        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
+        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
+        a0, a1 = (e[None] for e in _stick_ends(row))
+        for j in range(lo, hi):
+            pose_o = self._strokes[other][j][1]
+            b0, b1 = (e[None] for e in _stick_ends(np.concatenate([pose_o.grip, pose_o.rot])))
+            pa, pb = drummer_clear.segment_closest(a0 * _FLAT, a1 * _FLAT, b0 * _FLAT, b1 * _FLAT)
+            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
+                continue
+            pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
+            if pa[0, 1] > pb[0, 1]:
+                return True
+        return False
+
     def _wrist(self, hand: str, row: np.ndarray) -> np.ndarray:
         """The wrist of a (grip, rot, elbow) row."""
         return np.asarray(row[:3] - quat.rotate(row[3:7], self._grip_off[hand]))
@@ -725,7 +828,7 @@ class DrummerHands:
         for i, (t, (start, pose, vel, art)) in enumerate(zip(times, strokes, strict=True)):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
-            target = np.concatenate([pose.grip, pose.rot, pose.elbow])
+            target = self._over(hand, t, np.concatenate([pose.grip, pose.rot, pose.elbow]))
             if base is not None:
                 start = max(start, floor)
             if prev_t is None and base is None:
@@ -776,7 +879,15 @@ class DrummerHands:
                 off_hihat = prev_piece == "hihat"
                 _add(pt, pv, pp, t, target, _MOVE_OFF_HIHAT if off_hihat else _MOVE)
             else:  # squeezed by the plan: the straight, shortest way at even speed
-                _add(pt, pv, pp, t, target, _squeezed(float(way), t - cut))
+                shape = _squeezed(float(way), t - cut)
+                if (
+                    shape == _SQUEEZED
+                    and target[1] > here[1]
+                    and _over_peak_m_s(here[:3], target[:3], t - cut) <= _OVER_PEAK_M_S
+                    and self._crosses_over(hand, t, target)
+                ):
+                    shape = _SQUEEZED_OVER
+                _add(pt, pv, pp, t, target, shape)
             if reached is not target:  # known on the way: re-aimed from then
                 assert j is not None
                 _cut(pt, pv, pp, strokes[j][0], _pose_at)

@@ -42,8 +42,7 @@ def fast_moves(notes: list[dict[str, Any]], name: str, speed: float, memory_s: f
             dt = b["impact"] - a["impact"]
             if a["piece"] == b["piece"] or dt > memory_s:
                 continue
-            d = dist.get((a["piece"], b["piece"])) or dist.get((b["piece"], a["piece"])) or 0.0
-            v = d / max(dt, 1e-6)
+            v = dist.get((a["piece"], b["piece"]), 0.0) / max(dt, 1e-6)
             if v > speed:
                 out.append(
                     (v, name, hand, a["piece"], a["impact"], a["velocity"], b["piece"])

@@ -23,7 +23,7 @@ from virja.plan import drums as drums_mod
 from virja.plan.chain import GROUP_EPS_S, ChainContext, Held, WindowedPlan
 from virja.plan.chain_feet import FootChain
 from virja.plan.chain_kit import HAND_WINDOW_S, REBOUND_VELOCITY, DrumChain, DrumHeld, drum_stroke
-from virja.plan.config import DrumNote
+from virja.plan.config import DrumNote, Timing
 from virja.plan.types import DropReason, PlannedNote
 from virja.vocab import Hand
 
@@ -389,15 +389,7 @@ class HandsChain(DrumChain):
             return hp
 
         def solve(win: list[list[DrumHeld]], _gi: int) -> list[HandStep]:
-            hgs = [prepare(g).group for g in win]
-            sol = drums_mod.solve(
-                self.ctx.config.costs,
-                self.ctx.config.timing,
-                self.state,
-                hgs,
-                beam=self.ctx.bounds.beam,
-            )
-            return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
+            return self._steps([prepare(g).group for g in win])
 
         for gi in range(n_groups):
             hp = prepare(groups[gi])
@@ -470,6 +462,12 @@ class HandsChain(DrumChain):
         key = (tuple(groups), self.state)
         if self._shown is not None and self._shown[0] == key:
             return self._shown[1]
+        steps = self._steps(groups)
+        self._shown = (key, steps)
+        return steps
+
+    def _steps(self, groups: list[drums_mod.HandGroup]) -> list[HandStep]:
+        """The least-cost steps of ``groups`` from the chain's state (drums.solve)."""
         sol = drums_mod.solve(
             self.ctx.config.costs,
             self.ctx.config.timing,
@@ -477,9 +475,7 @@ class HandsChain(DrumChain):
             groups,
             beam=self.ctx.bounds.beam,
         )
-        steps = list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
-        self._shown = (key, steps)
-        return steps
+        return list(zip(sol.assignments, sol.stroke_costs, sol.states, strict=True))
 
     def _fix_group(
         self,
@@ -550,7 +546,7 @@ class HandsChain(DrumChain):
         timing = self.ctx.config.timing
         _prev, _pt, t_right, t_left, p_right, p_left = self.state
         for last, on in ((t_right, p_right), (t_left, p_left)):
-            if last is None or t - last >= timing.stretch_gap(on, piece) - drums_mod.TIME_EPS_S:
+            if _reach(timing, last, on, piece, t)[0]:
                 return "beyond_hand_speed"
         return "too_fast"
 
@@ -597,7 +593,6 @@ class HandsChain(DrumChain):
         away, riding on a snare note dropped as a third piece)."""
         t, piece = rec.note.time_s, rec.drum.piece
         timing = self.ctx.config.timing
-        top = max((pen for _speed, pen in timing.speed_tiers), default=math.inf)
         _prev, _pt, t_right, t_left, p_right, p_left = after
         fit: list[Hand] = []
         reached = False
@@ -605,15 +600,10 @@ class HandsChain(DrumChain):
             (drums_mod.RIGHT, t_right, p_right),
             (drums_mod.LEFT, t_left, p_left),
         ):
-            if last is None or on is None:
+            in_time, in_speed = _reach(timing, last, on, piece, t)
+            reached |= in_time
+            if in_speed:
                 fit.append(hand)
-                continue
-            a, b = (on, piece) if last <= t else (piece, on)
-            since = abs(t - last)
-            if since >= timing.stretch_gap(a, b) - drums_mod.TIME_EPS_S:
-                reached = True
-                if drums_mod.stroke_penalty(timing, a, b, since) < top:
-                    fit.append(hand)
         if fit:
             self.place_stroke(rec, timing.get(piece).min_interval_s, fit)
         else:
@@ -657,6 +647,23 @@ class HandsChain(DrumChain):
         self.emit_stroke([rec], rec.drum.piece, hand, cost)
         if self._bounced is not None:
             self._bounced.append((hand, rec.drum.piece, t, True))
+
+
+def _reach(
+    timing: Timing, last: float | None, on: str | None, piece: str, t: float
+) -> tuple[bool, bool]:
+    """Whether a hand whose stroke nearest ``t`` was on ``on`` at ``last`` (before or
+    after ``t``; None: none) strikes ``piece`` at ``t`` in time, at a stretch
+    (:meth:`Timing.stretch_gap`), and whether also under the top speed tier of
+    timing.toml [hand_speed] (a drummer's hands)."""
+    if last is None or on is None:
+        return True, True
+    a, b = (on, piece) if last <= t else (piece, on)
+    since = abs(t - last)
+    if since < timing.stretch_gap(a, b) - drums_mod.TIME_EPS_S:
+        return False, False
+    top = max((pen for _speed, pen in timing.speed_tiers), default=math.inf)
+    return True, drums_mod.stroke_penalty(timing, a, b, since) < top
 
 
 def _struck(state: drums_mod.HandState, bounced: list[Struck]) -> drums_mod.HandState:

@@ -89,6 +89,25 @@ def test_beat_lean_is_smaller_when_faster(library: MotionLibrary) -> None:
     assert lean_range(0.5) > 1.5 * lean_range(0.2)
 
 
+def test_the_sway_grows_with_the_beat_down_to_60_bpm(library: MotionLibrary) -> None:
+    """One beat of sway at 60 bpm turns the chest more than 3 degrees (GMD drummer7's
+    rock 60 fill: two strokes in a second, one beat in view, turned 2.97 degrees when
+    every tempo under 80 bpm swayed alike)."""
+
+    def sway_range(spb: float) -> float:
+        a = BandAnimator(library)
+        t0 = 1.0
+        for k in range(8):
+            a.add_beat(Beat(t0 + k * spb, k // 4, k % 4 + 1, 4, 0, round(spb * 1e6)))
+        t = np.arange(t0, t0 + spb, spb / 100)  # one beat
+        beats, bpms = np.asarray(a._beat_times), np.asarray(a._beat_spb)
+        return float(np.degrees(np.ptp(a.body._sway(t, beats, bpms))))
+
+    assert sway_range(1.0) > 3.5
+    assert sway_range(1.0) > 1.2 * sway_range(0.75)  # 60 bpm sways more than 80
+    assert sway_range(0.2) > 1.5  # and 300 bpm still turns
+
+
 def test_single_and_batched_poses_agree(library: MotionLibrary) -> None:
     a = BandAnimator(library)
     _groove(a, "ride", "snare", n=4)

@@ -12,7 +12,8 @@ stay where the clips put them:
 - **breathing**: the chest pitches slowly (``breath_deg`` at ``breath_period_s``).
 - **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
   ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
-  and the torso turns ``sway_deg`` one way on one beat, the other way on the next.
+  and the torso turns ``sway_deg`` one way on one beat, the other way on the next
+  (scaled the same way, clamped to ``sway_floor``-``sway_ceiling``).
 - **feathered kick**: on each beat with no kick near it the right ankle presses
   the kick's board a little (``feather_deg``, a cos^2 bump), as jazz drummers
   feather the bass drum: the idle foot is never frozen.
@@ -73,6 +74,7 @@ class BodySettings:
     beat_deg: float = 1.5
     sway_deg: float = 2.0
     sway_floor: float = 0.8
+    sway_ceiling: float = 2.0
     reference_spb: float = 0.5
     engage_s: float = 1.0
     release_s: float = 0.5
@@ -222,7 +224,9 @@ class DrummerBody:
         """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
         s = self.settings
         phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
-        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, s.sway_floor, 1.5)
+        amp = np.radians(s.sway_deg) * np.clip(
+            spb / s.reference_spb, s.sway_floor, s.sway_ceiling
+        )
         return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
 
     # ------------------------------------------------------------------ apply

@@ -139,6 +139,7 @@ class BeatTable(Schema):
     sway_deg: float
     reference_spb: float
     sway_floor: float | None = None  # absent: BodySettings' default
+    sway_ceiling: float | None = None  # absent: BodySettings' default
     feather_deg: float | None = None
     feather_width_s: float | None = None
     feather_clear_s: float | None = None
@@ -174,6 +175,9 @@ def body_settings(path: Path) -> BodySettings:
         beat_deg=f.beat.spine_deg,
         sway_deg=f.beat.sway_deg,
         sway_floor=BodySettings.sway_floor if f.beat.sway_floor is None else f.beat.sway_floor,
+        sway_ceiling=(
+            BodySettings.sway_ceiling if f.beat.sway_ceiling is None else f.beat.sway_ceiling
+        ),
         reference_spb=f.beat.reference_spb,
         engage_s=f.arms.engage_s,
         release_s=f.arms.release_s,

@@ -124,6 +124,11 @@ _DEPART_M = 0.02
 # a hand raised over the other stick at an impact (DrummerHands._over) in steps of this
 _OVER_STEP_M = 0.005
 _REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
+# the left under the right stick crossed over it (DrummerHands._under): right strokes
+# from this long before the left's impact (or its last impact, if later) to its next,
+# whose stick passes this near the left's (m)
+_UNDER_BEFORE_S = 0.25
+_UNDER_NEAR_M = 0.08
 
 
 @dataclass(frozen=True)
@@ -678,6 +683,62 @@ class DrummerHands:
                     return up
         return row
 
+    def _waits(self, gap: float) -> bool:
+        """Whether a hand whose next stroke comes ``gap`` s after its last hovers in
+        between (as :meth:`_build` times the rebound, the rise and the downstroke), or
+        rebounds straight into the next backswing."""
+        s = self.settings
+        down = min(max(s.down_share * gap, s.down_min_s), s.down_max_s, 0.5 * gap)
+        rise = min(2 * down + 0.05, 0.5 * gap)
+        return gap - down - rise > min(s.rebound_max_s, s.rebound_share * gap) + 1e-4
+
+    def _under(self, hand: str, t: float, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of the left hand's stroke at ``t``) with the wrist
+        lowered, turned about the tip, until its stick lies ``STICK_CLEAR_M`` under the
+        right stick wherever the right strikes within ``span`` (from the left's last
+        impact or _UNDER_BEFORE_S before this one to its next) crossed over it seen from
+        above and within _UNDER_NEAR_M of it: the right arm crossed over onto the
+        hi-hat, the left plays the drums beneath it.  At most ``reach_max_m``; the
+        unchanged ``row`` where that is not enough (GMD latin-chacarera 118 at 8.12 s:
+        the left on the high tom, its butt at the height of the right stick, which rose
+        into it with each hi-hat stroke while the left waited there)."""
+        if hand != HANDS[0]:
+            return row
+        other = HANDS[1]
+        times = self._times[other]
+        lo = bisect.bisect_left(times, span[0])
+        hi = bisect.bisect_left(times, span[1])
+        a0, a1 = (e[None] for e in _stick_ends(row))
+        over: list[tuple[np.ndarray, np.ndarray]] = []
+        for j in range(lo, hi):
+            pose_o = self._strokes[other][j][1]
+            b0, b1 = (e[None] for e in _stick_ends(np.concatenate([pose_o.grip, pose_o.rot])))
+            pa, pb = drummer_clear.segment_closest(a0 * _FLAT, a1 * _FLAT, b0 * _FLAT, b1 * _FLAT)
+            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
+                continue  # not crossed seen from above
+            pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
+            if float(np.linalg.norm(pa - pb)) < _UNDER_NEAR_M:
+                over.append((b0, b1))
+        if not over:
+            return row
+
+        def beneath(r: np.ndarray) -> bool:
+            c0, c1 = (e[None] for e in _stick_ends(r))
+            for b0, b1 in over:
+                pa, pb = drummer_clear.segment_closest(c0, c1, b0, b1)
+                if pa[0, 1] >= pb[0, 1] or np.linalg.norm(pa - pb) < drummer_clear.STICK_CLEAR_M:
+                    return False
+            return True
+
+        if beneath(row):
+            return row
+        wrist = self._wrist(hand, row)
+        for k in range(1, 1 + int(self.settings.reach_max_m / _OVER_STEP_M + 1e-9)):
+            down = self._reach(hand, row, wrist - _UP, k * _OVER_STEP_M)
+            if beneath(down):
+                return down
+        return row
+
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
         """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
         other hand's stick, crossed seen from above (under ``STICK_CLEAR_M``), at an
@@ -828,7 +889,15 @@ class DrummerHands:
         for i, (t, (start, pose, vel, art)) in enumerate(zip(times, strokes, strict=True)):
             if t <= floor or (prev_t is not None and t - prev_t < 1e-6):
                 continue  # two notes struck at once by one hand: one stroke
-            target = self._over(hand, t, np.concatenate([pose.grip, pose.rot, pose.elbow]))
+            row = np.concatenate([pose.grip, pose.rot, pose.elbow])
+            nxt_t = next((u for u in times[i + 1 :] if u - t >= 1e-6), math.inf)
+            since = t - _UNDER_BEFORE_S if prev_t is None else max(prev_t, t - _UNDER_BEFORE_S)
+            until = min(nxt_t, t + 0.5 * s.rest_after_s)  # then it rests
+            target = row
+            if nxt_t == math.inf or self._waits(nxt_t - t):
+                target = self._under(hand, t, (since, until), row)
+            if target is row:
+                target = self._over(hand, t, row)
             if base is not None:
                 start = max(start, floor)
             if prev_t is None and base is None:

@@ -286,6 +286,20 @@ def test_a_hand_crossing_over_the_other_to_the_hihat_rises_before_it_crosses() -
     _meets_targets(_report(GMD / "drummer8_session2_25_latin_84_beat_4-4.mid", 2.0))
 
 
+@pytest.mark.parametrize("live", [False, True])
+def test_a_left_hand_waiting_under_the_crossed_right_stick_stays_under_it(live: bool) -> None:
+    """GMD latin chacarera 118 (drummer1 session2 take 2), first 9 s: the right hand,
+    crossed over onto the hi-hat, plays on (7.950, 8.123, 8.274, 8.440 s) while the left
+    strikes the high tom (8.119 s) and waits there for the snare (8.596 s).  The clips'
+    impact poses on the tom and the hi-hat cross 1 mm apart, the left's butt at the
+    height of the right stick; the left was raised over it (the louder of two strokes
+    within 30 ms) and the right stick rose into its butt with each backswing: on main
+    0c40dbc stick-stick 3 (7.98-8.45 s).  The left, which waits there, now lands with its
+    wrist lowered under the right stick, turned about its tip."""
+    name = "drummer1_session2_2_latin-chacarera_118_beat_4-4.mid"
+    _meets_targets(_report(GMD / name, 9.0, live))
+
+
 def _meets_targets(fig: dict[str, object]) -> None:
     collisions = fig["collisions"]
     assert isinstance(collisions, dict)

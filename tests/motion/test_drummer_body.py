@@ -77,6 +77,30 @@ def test_a_resting_hand_breathes_with_the_body(library: MotionLibrary) -> None:
     assert np.ptp(pos0, axis=0).max() < 1e-9
 
 
+def test_a_resting_hand_rides_the_sway_not_the_turn(library: MotionLibrary) -> None:
+    """The right hand gone to rest after the hi-hat while the left plays on the snare:
+    the torso stays turned toward them (about 12 deg), and a resting hand carried by
+    the whole turn drifted 12 cm from its track, into the left stick over the snare
+    (MMA jazzcombo 60 at 12.5 s).  It now rides only with the beat's sway."""
+    live = BandAnimator(library)
+    still = BandAnimator(library, body=BodySettings.still())
+    for a in (live, still):
+        for k in range(5):
+            a.add_beat(Beat(1.0 + k, k // 4, k % 4 + 1, 4, 0, 1_000_000))  # 60 bpm
+        a.add_planned(drum("hihat_right_hand", 0.8, 1.0))
+        for k in range(8):
+            a.add_planned(drum("snare_left_hand", 1.0 + 0.5 * k, 1.2 + 0.5 * k))
+    times = np.arange(3.0, 4.6, 0.05)  # the right at rest (its last stroke 2 s before)
+    wrist = SKELETON.index("RightHand")
+    moved = [
+        float(np.linalg.norm(x.drums.positions[wrist] - y.drums.positions[wrist]))
+        for x, y in zip(live.poses(times), still.poses(times), strict=True)
+    ]
+    assert np.abs(np.degrees(live.body.turn(times))).min() > 8.0
+    assert max(moved) < 0.045  # the sway: at most 4 deg at 60 bpm
+    assert max(moved) > 0.003  # ... but not frozen
+
+
 def test_beat_lean_is_smaller_when_faster(library: MotionLibrary) -> None:
     def lean_range(spb: float) -> float:
         a = BandAnimator(library)

@@ -23,7 +23,8 @@ stay where the clips put them:
   hand keeps its authored world rotation: the grip and the stick are where
   the clip put them, so contact and timing at impact are unchanged.  Further
   from its strokes a resting hand blends (over ``release_s``) to riding with
-  the body: it breathes and sways instead of hanging frozen in space.
+  the body's sway about the spine (not its turn toward the pieces, which would
+  carry it into the other stick): it sways instead of hanging frozen in space.
 
 Before the first hand stroke the drummer sits still (the body wakes over the
 ``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals; only the right
@@ -299,14 +300,35 @@ class DrummerBody:
         r = np.zeros(mat.shape[:-2] + (4,))
         r[:, _ARM_JOINTS] = quat.from_matrix(mat[:, _ARM_JOINTS])
         p0, r0, p1, r1 = p[:m], r[:m], p[m:], r[m:]
+        # a resting hand rides with the beat's sway about the spine, not with the turn
+        # toward the pieces: carried by the whole turn (up to 12 deg + the sway) a hand
+        # gone to rest drifted 12 cm from where its track put it, into the other stick
+        # hovering over the snare (MMA jazzcombo 60 at 12.5 s, the right resting while
+        # the left waits on the snare)
+        sway = awake * self._sway(t, beat_times, beat_spb)
         for hand in HANDS:
             c = self.engagement(hand, t)
-            if not np.any(c > 0):
+            rows = np.flatnonzero((awake > 0.0) | (c > 0.0))
+            if rows.size == 0:
                 continue
             sh, arm, fore, wrist = _ARMS[hand]
-            solved = _resolve_arm(p0, r0, p1[:, arm], r1[:, sh], arm, fore, wrist)
-            for j, q in zip((arm, fore, wrist), solved, strict=True):
-                out[:, j] = quat.slerp(out[:, j], q, c)
+            ride = (1.0 - c) * sway
+            if rows.size == len(t):  # every frame (no copies)
+                pm, rm, sh_p, sh_r = p0, r0, p1[:, arm], r1[:, sh]
+            else:
+                pm, rm, sh_p, sh_r = p0[rows], r0[rows], p1[rows, arm], r1[rows, sh]
+                ride = ride[rows]
+            turned = np.flatnonzero(ride)  # resting: the authored arm carried by the sway
+            if turned.size:
+                pm, rm = pm.copy(), rm.copy()
+                q = quat.from_axis_angle(_UP, ride[turned])
+                centre = pm[turned, _SPINE]
+                for j in (arm, fore, wrist):
+                    pm[turned, j] = centre + quat.rotate(q, pm[turned, j] - centre)
+                    rm[turned, j] = quat.multiply(q, rm[turned, j])
+            solved = _resolve_arm(pm, rm, sh_p, sh_r, arm, fore, wrist)
+            for j, got in zip((arm, fore, wrist), solved, strict=True):
+                out[rows, j] = got
         return out
 
 

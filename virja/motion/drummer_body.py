@@ -225,9 +225,7 @@ class DrummerBody:
         """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
         s = self.settings
         phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
-        amp = np.radians(s.sway_deg) * np.clip(
-            spb / s.reference_spb, s.sway_floor, s.sway_ceiling
-        )
+        amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, s.sway_floor, s.sway_ceiling)
         return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
 
     # ------------------------------------------------------------------ apply

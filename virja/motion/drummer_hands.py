@@ -16,7 +16,8 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   leaves less time than that goes at even speed between short ramps
   (``_SQUEEZED``), and the stick takes part of it: at the impacts on either side
   the hand and stick are turned about the tip so the wrist sits toward the other
-  piece (``reach_*``, :meth:`DrummerHands._reached`, also where the hands cross);
+  piece (``reach_*``, :func:`virja.motion.drummer_landing.reached`, also where the
+  hands cross);
   a hand over a cymbal (or on the spot of a drum) that the other hand strikes
   next gets out of its way low and sideways (:meth:`DrummerHands._yield`).
 - **lift**: velocity sets the stick tip's height above the surface (not a
@@ -31,8 +32,11 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   is interpolated between keys (grip and elbow lerp, hand rotation slerp).
 - **crossed at once**: where the two hands strike within ``BEFORE_IMPACT_S`` of each
   other (no detour bends a track there), the louder stroke's hand lands raised over
-  the other stick (:meth:`DrummerHands._over`), and a squeezed move up to a stroke
-  that ends crossed over the other stick gets its height first (``_SQUEEZED_OVER``).
+  the other stick (:func:`virja.motion.drummer_landing.over`), and a squeezed move up
+  to a stroke that ends crossed over the other stick gets its height first
+  (``_SQUEEZED_OVER``).  A left hand that waits on a drum (hovers before its next
+  stroke) under the right stick crossed over it onto the hi-hat lands lowered under
+  that stick instead (:func:`virja.motion.drummer_landing.under`).
 - **apart**: the two hands' tracks are sampled together and bent around each
   other and the kit where a stick would go through the other or a tip under a
   piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).
@@ -56,7 +60,7 @@ from typing import Any
 import numpy as np
 
 from virja.geometry import GEOMETRY, DrumKit
-from virja.motion import drummer_clear, quat
+from virja.motion import drummer_clear, drummer_landing, quat
 from virja.motion.clip import Clip
 from virja.motion.ik import frames
 from virja.motion.skeleton import SKELETON, STICK_AXIS_LOCAL, STICK_BUTT_M, STICK_TIP_M
@@ -66,7 +70,6 @@ _SK = SKELETON
 HANDS = ("left_hand", "right_hand")
 _SIDE = {"left_hand": "Left", "right_hand": "Right"}
 _UP = np.array([0.0, 1.0, 0.0])
-_FLAT = np.array([1.0, 0.0, 1.0])  # seen from above
 _SMOOTH, _ACCEL, _DECEL = 0, 1, 2
 _MOVE = 3  # eased like _SMOOTH; the grip's height leads or lags (_height_share)
 _RISE_LEAD, _DROP_LAG = 1.5, 2.0  # exponents, see _height_share
@@ -121,14 +124,9 @@ _REACH_MIN_S = 0.04
 # a stroke whose piece lies this far from where the hand is moves the hand toward it
 # (DrummerHands.departs); nearer, only the stick's backswing shows it (the hand stays)
 _DEPART_M = 0.02
-# a hand raised over the other stick at an impact (DrummerHands._over) in steps of this
-_OVER_STEP_M = 0.005
-_REACH_SLACK_M = 0.04  # see DrummerHands._reach (a left hand on the ride: 3.8 mm off)
 # the left under the right stick crossed over it (DrummerHands._under): right strokes
-# from this long before the left's impact (or its last impact, if later) to its next,
-# whose stick passes this near the left's (m)
+# from this long before the left's impact (or its last impact, if later) to its next
 _UNDER_BEFORE_S = 0.25
-_UNDER_NEAR_M = 0.08
 
 
 @dataclass(frozen=True)
@@ -217,17 +215,6 @@ class _Base:
     lv: list[float]
     lp: list[Any]
     last: tuple[float, float, np.ndarray, str | None] | None
-
-
-def _tip(row: np.ndarray) -> np.ndarray:
-    """The stick's tip of a (grip, rot, ...) row."""
-    return np.asarray(row[:3] + STICK_TIP_M * quat.rotate(row[3:7], STICK_AXIS_LOCAL))
-
-
-def _stick_ends(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The stick's butt and tip of a (grip, rot, ...) row."""
-    axis = quat.rotate(row[3:7], STICK_AXIS_LOCAL)
-    return row[:3] - STICK_BUTT_M * axis, row[:3] + STICK_TIP_M * axis
 
 
 def _same_until(a: _Keys, b: _Keys, t: float) -> bool:
@@ -432,6 +419,10 @@ class DrummerHands:
             h: float(np.linalg.norm(_SK.offsets[_SK.index(f"{_SIDE[h]}Hand")])) for h in HANDS
         }
         self._grip_off = {h: _SK.offsets[_SK.index(f"{_SIDE[h]}HandEnd")] for h in HANDS}
+        self._arm = {
+            h: drummer_landing.Arm(self._shoulder[h], self._l1[h], self._l2[h], self._grip_off[h])
+            for h in HANDS
+        }
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
         # per stroke: (start, impact pose, velocity, articulation)
         self._strokes: dict[str, list[tuple[float, _Pose, int, str | None]]] = {
@@ -630,8 +621,11 @@ class DrummerHands:
             start_o, pose_o, _v, _a = self._strokes[other][j]
             if pose_o.piece != piece:
                 continue
-            tip_o = _tip(np.concatenate([pose_o.grip, pose_o.rot]))
-            if piece not in _YIELDING and np.linalg.norm(tip_o - _tip(row)) > _YIELD_NEAR_M:
+            tip_o = drummer_landing.tip(np.concatenate([pose_o.grip, pose_o.rot]))
+            if (
+                piece not in _YIELDING
+                and np.linalg.norm(tip_o - drummer_landing.tip(row)) > _YIELD_NEAR_M
+            ):
                 return None  # alternating on a drum, each on its own spot
             cut = max(start_o, t + _YIELD_AFTER_S)
             if cut >= t + 0.5 * self.settings.rest_after_s:
@@ -641,47 +635,34 @@ class DrummerHands:
             return out if t_o - cut >= _YIELD_MIN_S else None
         return None
 
-    def _over(self, hand: str, t: float, row: np.ndarray) -> np.ndarray:
-        """``row`` (the impact pose of ``hand``'s stroke at ``t``) with the hand raised
-        over the other stick, turned about its tip, where the other hand strikes within
-        ``drummer_clear.BEFORE_IMPACT_S`` with its stick (at its impact) crossing this
-        one under ``STICK_TRIGGER_M``: there neither track may be bent (the detours
-        are zero that near an impact), so the two impact poses themselves must lie
-        apart.  Of the two, the stick higher where they cross goes over: its hand
-        rises until ``STICK_CLEAR_M`` lies between them, at most ``reach_max_m`` (the
-        left on the high tom 13 ms before the right, crossed over it, on the hi-hat:
-        GMD neworleans-funk 84 fill at 0.03 s, the sticks 1 mm apart at both impacts)."""
+    def _others(
+        self, hand: str, lo: float, hi: float, *, up_to: bool = True
+    ) -> list[tuple[np.ndarray, int, str | None]]:
+        """The other hand's strokes with impacts from ``lo`` to ``hi`` (``hi`` itself
+        only ``up_to``): (impact row of grip and rotation, velocity, articulation)."""
         other = HANDS[1 - HANDS.index(hand)]
         times = self._times[other]
-        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
-        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
+        end = (bisect.bisect_right if up_to else bisect.bisect_left)(times, hi)
+        return [
+            (np.concatenate([pose.grip, pose.rot]), vel, art)
+            for _s, pose, vel, art in self._strokes[other][bisect.bisect_left(times, lo) : end]
+        ]
+
+    def _over(self, hand: str, t: float, row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of ``hand``'s stroke at ``t``) raised over the other
+        stick where the other hand strikes within ``drummer_clear.BEFORE_IMPACT_S`` with
+        the sticks crossed (:func:`drummer_landing.over`)."""
+        near = drummer_clear.BEFORE_IMPACT_S
         _start, _pose, vel, art = self._strokes[hand][bisect.bisect_left(self._times[hand], t)]
+        others = [
+            (r, self._lift_for(v, math.inf, a))
+            for r, v, a in self._others(hand, t - near, t + near)
+        ]
         lift = self._lift_for(vel, math.inf, art)
-        for j in range(lo, hi):
-            _s, pose_o, vel_o, art_o = self._strokes[other][j]
-            lift_o = self._lift_for(vel_o, math.inf, art_o)
-            b0, b1 = _stick_ends(np.concatenate([pose_o.grip, pose_o.rot]))
-            a0, a1 = _stick_ends(row)
-            pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
-            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_TRIGGER_M:
-                continue
-            # the same pair seen from the other hand's build: one of them goes over
-            if abs(lift - lift_o) > 1e-9:
-                if lift < lift_o:
-                    continue
-            elif abs(float(pa[0, 1] - pb[0, 1])) > 1e-9:
-                if pa[0, 1] < pb[0, 1]:
-                    continue
-            elif hand != HANDS[1]:
-                continue
-            wrist = self._wrist(hand, row)
-            for k in range(1, 1 + int(self.settings.reach_max_m / _OVER_STEP_M + 1e-9)):
-                up = self._reach(hand, row, wrist + _UP, k * _OVER_STEP_M)
-                a0, a1 = _stick_ends(up)
-                pa, pb = drummer_clear.segment_closest(a0[None], a1[None], b0[None], b1[None])
-                if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
-                    return up
-        return row
+        arm = self._arm[hand]
+        return drummer_landing.over(
+            arm, row, lift, others, hand == HANDS[1], self.settings.reach_max_m
+        )
 
     def _waits(self, gap: float) -> bool:
         """Whether a hand whose next stroke comes ``gap`` s after its last hovers in
@@ -692,129 +673,31 @@ class DrummerHands:
         rise = min(2 * down + 0.05, 0.5 * gap)
         return gap - down - rise > min(s.rebound_max_s, s.rebound_share * gap) + 1e-4
 
-    def _under(self, hand: str, t: float, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
-        """``row`` (the impact pose of the left hand's stroke at ``t``) with the wrist
-        lowered, turned about the tip, until its stick lies ``STICK_CLEAR_M`` under the
-        right stick wherever the right strikes within ``span`` (from the left's last
-        impact or _UNDER_BEFORE_S before this one to its next) crossed over it seen from
-        above and within _UNDER_NEAR_M of it: the right arm crossed over onto the
-        hi-hat, the left plays the drums beneath it.  At most ``reach_max_m``; the
-        unchanged ``row`` where that is not enough (GMD latin-chacarera 118 at 8.12 s:
-        the left on the high tom, its butt at the height of the right stick, which rose
-        into it with each hi-hat stroke while the left waited there)."""
+    def _under(self, hand: str, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of a left-hand stroke) lowered under the right stick
+        wherever the right strikes within ``span`` (from the left's last impact or
+        _UNDER_BEFORE_S before this one, to its next): :func:`drummer_landing.under`."""
         if hand != HANDS[0]:
             return row
-        other = HANDS[1]
-        times = self._times[other]
-        lo = bisect.bisect_left(times, span[0])
-        hi = bisect.bisect_left(times, span[1])
-        a0, a1 = (e[None] for e in _stick_ends(row))
-        over: list[tuple[np.ndarray, np.ndarray]] = []
-        for j in range(lo, hi):
-            pose_o = self._strokes[other][j][1]
-            b0, b1 = (e[None] for e in _stick_ends(np.concatenate([pose_o.grip, pose_o.rot])))
-            pa, pb = drummer_clear.segment_closest(a0 * _FLAT, a1 * _FLAT, b0 * _FLAT, b1 * _FLAT)
-            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
-                continue  # not crossed seen from above
-            pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
-            if float(np.linalg.norm(pa - pb)) < _UNDER_NEAR_M:
-                over.append((b0, b1))
-        if not over:
-            return row
-
-        def beneath(r: np.ndarray) -> bool:
-            c0, c1 = (e[None] for e in _stick_ends(r))
-            for b0, b1 in over:
-                pa, pb = drummer_clear.segment_closest(c0, c1, b0, b1)
-                if pa[0, 1] >= pb[0, 1] or np.linalg.norm(pa - pb) < drummer_clear.STICK_CLEAR_M:
-                    return False
-            return True
-
-        if beneath(row):
-            return row
-        wrist = self._wrist(hand, row)
-        for k in range(1, 1 + int(self.settings.reach_max_m / _OVER_STEP_M + 1e-9)):
-            down = self._reach(hand, row, wrist - _UP, k * _OVER_STEP_M)
-            if beneath(down):
-                return down
-        return row
+        others = [r for r, _v, _a in self._others(hand, span[0], span[1], up_to=False)]
+        return drummer_landing.under(self._arm[hand], row, others, self.settings.reach_max_m)
 
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
         """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
         other hand's stick, crossed seen from above (under ``STICK_CLEAR_M``), at an
         impact of the other within ``drummer_clear.BEFORE_IMPACT_S``."""
-        other = HANDS[1 - HANDS.index(hand)]
-        times = self._times[other]
-        lo = bisect.bisect_left(times, t - drummer_clear.BEFORE_IMPACT_S)
-        hi = bisect.bisect_right(times, t + drummer_clear.BEFORE_IMPACT_S)
-        a0, a1 = (e[None] for e in _stick_ends(row))
-        for j in range(lo, hi):
-            pose_o = self._strokes[other][j][1]
-            b0, b1 = (e[None] for e in _stick_ends(np.concatenate([pose_o.grip, pose_o.rot])))
-            pa, pb = drummer_clear.segment_closest(a0 * _FLAT, a1 * _FLAT, b0 * _FLAT, b1 * _FLAT)
-            if float(np.linalg.norm(pa - pb)) >= drummer_clear.STICK_CLEAR_M:
-                continue
-            pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
-            if pa[0, 1] > pb[0, 1]:
-                return True
-        return False
-
-    def _wrist(self, hand: str, row: np.ndarray) -> np.ndarray:
-        """The wrist of a (grip, rot, elbow) row."""
-        return np.asarray(row[:3] - quat.rotate(row[3:7], self._grip_off[hand]))
-
-    def _reach(self, hand: str, row: np.ndarray, toward: np.ndarray, dist: float) -> np.ndarray:
-        """``row`` with the hand and stick turned about the stick's tip so that the wrist
-        sits up to ``dist`` nearer ``toward`` (a wrist position; the part of the way
-        square to the stick, which is all a turn about the tip can give): the tip stays
-        exactly where it was, the stick takes part of a far move (:meth:`_reached`)."""
-        grip, rot = row[:3], row[3:7]
-        tip = _tip(row)
-        r = self._wrist(hand, row) - tip
-        lever = float(np.linalg.norm(r))
-        way = toward - (tip + r)
-        r_hat = r / lever
-        way = way - float(way @ r_hat) * r_hat
-        norm = float(np.linalg.norm(way))
-        if dist <= 1e-4 or norm < 1e-6:
-            return row
-        axis = np.cross(r_hat, way / norm)
-        axis = axis / np.linalg.norm(axis)
-        theta = math.asin(min(dist, norm, 0.9 * lever) / lever)
-        # never nearer full stretch than _REACH_SLACK_M (nor than the clip's own pose):
-        # the body's turn moves the shoulder, and an arm out of reach misses the piece
-        shoulder = self._shoulder[hand]
-        full = self._l1[hand] + self._l2[hand] - _REACH_SLACK_M
-        limit = max(full, float(np.linalg.norm(tip + r - shoulder)))
-        for _ in range(6):
-            q = quat.from_axis_angle(axis, theta)
-            if float(np.linalg.norm(tip + quat.rotate(q, r) - shoulder)) <= limit:
-                break
-            theta *= 0.5
-        else:
-            return row
-        out = row.copy()
-        out[:3] = tip + quat.rotate(q, grip - tip)
-        out[3:7] = quat.multiply(q, rot)
-        return out
+        near = drummer_clear.BEFORE_IMPACT_S
+        others = [r for r, _v, _a in self._others(hand, t - near, t + near)]
+        return drummer_landing.crosses_over(row, others)
 
     def _reached(
         self, hand: str, row: np.ndarray, here: np.ndarray, span: float, share: float
     ) -> np.ndarray:
-        """``row`` reaching toward ``here`` (a row) when the wrist's way between them in
-        ``span`` s is longer than ``reach_speed_m_s`` allows: by ``share`` of the excess,
-        at most ``reach_max_m``.  Also where the hands cross (a left hand on the ride
-        while the right plays the hi-hat): a stick turned about its tip there swept
-        through the other stick (MMA Swing1 at 300 bpm) and was withheld until the
-        tracks were kept apart as paths (:meth:`_clear`); withheld, the crossed hand's
-        wrist went the whole way (0.6 m in 164 ms: 16.7 cm a frame at 30 fps, MMA
-        Swing1 at 240 bpm)."""
+        """``row`` reaching toward ``here`` (:func:`drummer_landing.reached`)."""
         s = self.settings
-        a, b = self._wrist(hand, row), self._wrist(hand, here)
-        excess = float(np.linalg.norm(a - b)) - s.reach_speed_m_s * max(span, 0.0)
-        if excess <= 0.0:
-            return row
-        return self._reach(hand, row, b, min(share * excess, s.reach_max_m))
+        return drummer_landing.reached(
+            self._arm[hand], row, here, span, share, s.reach_speed_m_s, s.reach_max_m
+        )
 
     def _build(self, hand: str) -> _Keys:
         """The key tracks of ``hand``: after each stroke its tail (rebound, hover, rest
@@ -860,7 +743,7 @@ class DrummerHands:
                 side = self._shoulder[hand] - self._shoulder[HANDS[1 - HANDS.index(hand)]]
                 side[1] = 0.0
             side = side / float(np.linalg.norm(side))
-            if float(side @ (self._wrist(hand, here) - tip_o)) < 0.0:
+            if float(side @ (self._arm[hand].wrist(here) - tip_o)) < 0.0:
                 side = -side
             # aside of the stroke's own spot (where the hand waits after it), not of where
             # it is: a track frozen live after the hand got out of the way is built on
@@ -895,7 +778,7 @@ class DrummerHands:
             until = min(nxt_t, t + 0.5 * s.rest_after_s)  # then it rests
             target = row
             if nxt_t == math.inf or self._waits(nxt_t - t):
-                target = self._under(hand, t, (since, until), row)
+                target = self._under(hand, (since, until), row)
             if target is row:
                 target = self._over(hand, t, row)
             if base is not None:

@@ -673,13 +673,26 @@ class DrummerHands:
         rise = min(2 * down + 0.05, 0.5 * gap)
         return gap - down - rise > min(s.rebound_max_s, s.rebound_share * gap) + 1e-4
 
-    def _under(self, hand: str, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
-        """``row`` (the impact pose of a left-hand stroke) lowered under the right stick
-        wherever the right strikes within ``span`` (from the left's last impact or
-        _UNDER_BEFORE_S before this one, to its next): :func:`drummer_landing.under`."""
+    def _under(
+        self, hand: str, t: float, span: tuple[float, float], waits: bool, row: np.ndarray
+    ) -> np.ndarray:
+        """``row`` (the impact pose of a left-hand stroke at ``t``) lowered under the right
+        stick crossed over it (:func:`drummer_landing.under`) where the right strikes
+        within ``span`` (from the left's last impact or _UNDER_BEFORE_S before this one,
+        to its next): all of them when the left ``waits`` there (hovers before its next
+        stroke); else only those up to ``t``, and not at all when one after ``t`` crosses
+        it (the left's rebound rises straight into its next backswing, which would come
+        up through that stick: the louder goes over then, :meth:`_over`).  A left coming
+        up from the snare to the high tom under the right stick leaving the hi-hat 100
+        ms before: GMD merengue 130 at 18.0 s."""
         if hand != HANDS[0]:
             return row
         others = [r for r, _v, _a in self._others(hand, span[0], span[1], up_to=False)]
+        if not waits:
+            later = [r for r, _v, _a in self._others(hand, t, span[1], up_to=False)]
+            if drummer_landing.crossing(row, later):
+                return row
+            others = others[: len(others) - len(later)]
         return drummer_landing.under(self._arm[hand], row, others, self.settings.reach_max_m)
 
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
@@ -776,9 +789,9 @@ class DrummerHands:
             nxt_t = next((u for u in times[i + 1 :] if u - t >= 1e-6), math.inf)
             since = t - _UNDER_BEFORE_S if prev_t is None else max(prev_t, t - _UNDER_BEFORE_S)
             until = min(nxt_t, t + 0.5 * s.rest_after_s)  # then it rests
-            target = row
-            if nxt_t == math.inf or self._waits(nxt_t - t):
-                target = self._under(hand, (since, until), row)
+            target = self._under(
+                hand, t, (since, until), nxt_t == math.inf or self._waits(nxt_t - t), row
+            )
             if target is row:
                 target = self._over(hand, t, row)
             if base is not None:

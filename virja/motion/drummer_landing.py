@@ -187,6 +187,30 @@ def crosses_over(row: np.ndarray, others: Sequence[np.ndarray]) -> bool:
     return False
 
 
+def _behind(row: np.ndarray, other: np.ndarray) -> bool:
+    """Whether the stick of ``other`` crosses the stick of ``row``, seen from above,
+    behind its middle (toward the hand, not where two tips meet on one piece)."""
+    a0, a1 = (e[None] * _FLAT for e in stick_ends(row))
+    b0, b1 = (e[None] * _FLAT for e in stick_ends(other))
+    pa, _pb = drummer_clear.segment_closest(a0, a1, b0, b1)
+    return float(np.linalg.norm(pa - a0)) < 0.5 * float(np.linalg.norm(a1 - a0))
+
+
+def crossing(row: np.ndarray, others: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """Those of ``others`` (rows) whose stick crosses the stick of ``row`` seen from above
+    (under ``STICK_CLEAR_M``), behind its middle, and passes within ``UNDER_NEAR_M`` of
+    it: the right stick crossed over onto the hi-hat lies over the left's hand (at 11 %
+    of the left stick from its butt in GMD merengue 130 at 18.0 s), a right stroke on the
+    tom the left plays meets it at the tips (100 %)."""
+    return [
+        other
+        for other in others
+        if _closest(row, other, flat=True)[0] < drummer_clear.STICK_CLEAR_M
+        and _behind(row, other)
+        and _closest(row, other)[0] < UNDER_NEAR_M
+    ]
+
+
 def under(arm: Arm, row: np.ndarray, others: Sequence[np.ndarray], max_m: float) -> np.ndarray:
     """``row`` (the impact pose of a left-hand stroke) with the wrist lowered, turned
     about the tip, until its stick lies ``STICK_CLEAR_M`` under each of ``others`` (the
@@ -196,12 +220,7 @@ def under(arm: Arm, row: np.ndarray, others: Sequence[np.ndarray], max_m: float)
     ``max_m``; the unchanged ``row`` where that is not enough (GMD latin-chacarera 118
     at 8.12 s: the left on the high tom, its butt at the height of the right stick,
     which rose into it with each hi-hat stroke while the left waited there)."""
-    near = [
-        other
-        for other in others
-        if _closest(row, other, flat=True)[0] < drummer_clear.STICK_CLEAR_M
-        and _closest(row, other)[0] < UNDER_NEAR_M
-    ]
+    near = crossing(row, others)
     if not near:
         return row
 
@@ -222,4 +241,4 @@ def under(arm: Arm, row: np.ndarray, others: Sequence[np.ndarray], max_m: float)
     return row
 
 
-__all__ = ["Arm", "crosses_over", "over", "reached", "stick_ends", "tip", "under"]
+__all__ = ["Arm", "crosses_over", "crossing", "over", "reached", "stick_ends", "tip", "under"]

@@ -300,6 +300,32 @@ def test_a_left_hand_waiting_under_the_crossed_right_stick_stays_under_it(live: 
     _meets_targets(_report(GMD / name, 9.0, live))
 
 
+@pytest.mark.parametrize("live", [False, True])
+def test_a_left_coming_up_to_the_tom_under_the_right_leaving_the_hihat_stays_under(
+    live: bool,
+) -> None:
+    """GMD latin dominican merengue 130 (drummer5 session1 take 9), first 18.6 s: the
+    right strikes the hi-hat (17.994 s), crossed over the left, which comes up from a
+    side-stick on the snare (17.854 s) to the high tom (18.094 s); the right goes on to
+    the same tom (18.204 s).  Both strokes lie in the 30 ms guards of the run where the
+    left's stick rose through the right one (17.99-18.08 s), the two impact poses 1 mm
+    apart, and the left does not wait on the tom (its next stroke 212 ms later): on main
+    0c40dbc stick-stick 3.  The left now lands under the right stick (every right
+    stroke crossing it behind its middle comes before its impact)."""
+    name = "drummer5_session1_9_latin-dominican-merengue_130_beat_4-4.mid"
+    _meets_targets(_report(GMD / name, 18.6, live))
+
+
+def test_no_detour_keeping_the_sticks_18_mm_apart_the_farthest_is_made() -> None:
+    """GMD dance-disco 137 (drummer8 session2 take 27), first 6.5 s: the left comes down
+    from the hi-hat (5.580 s) to the snare (5.903 s) past the right stick landing on the
+    hi-hat (5.828 s), inside the right's guard.  The best pull-back of the left keeps the
+    sticks 17.3 mm apart, under STICK_APART_M: none was made, stick-stick 1 on main
+    0c40dbc.  It is made now (at least STICK_NEAR_M, 2 mm clear of touching)."""
+    name = "drummer8_session2_27_dance-disco_137_beat_4-4.mid"
+    _meets_targets(_report(GMD / name, 6.5, False))
+
+
 def _meets_targets(fig: dict[str, object]) -> None:
     collisions = fig["collisions"]
     assert isinstance(collisions, dict)

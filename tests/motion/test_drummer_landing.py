@@ -7,7 +7,16 @@ import numpy as np
 from virja.motion import drummer_clear
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary
-from virja.motion.drummer_landing import Arm, crosses_over, over, reached, stick_ends, tip, under
+from virja.motion.drummer_landing import (
+    Arm,
+    crosses_over,
+    crossing,
+    over,
+    reached,
+    stick_ends,
+    tip,
+    under,
+)
 
 
 def _row(a: BandAnimator, library: MotionLibrary, name: str) -> np.ndarray:
@@ -81,3 +90,14 @@ def test_reached_turns_the_wrist_toward_a_far_piece_only_when_short_of_time(
     assert 0.01 < moved < 0.13  # max_m of the way square to the stick (a turn: an arc)
     nearer = np.linalg.norm(arm.wrist(short) - arm.wrist(crash))
     assert nearer < way
+
+
+def test_a_right_stroke_on_the_left_s_own_tom_does_not_cross_it(library: MotionLibrary) -> None:
+    """Crossed over the left's hand (the right on the hi-hat) counts; the right's tip
+    meeting the left's on the tom both play does not (the left is not under it)."""
+    a = BandAnimator(library)
+    left = _row(a, library, "tom_high_left_hand")
+    hihat = _row(a, library, "hihat_right_hand")
+    tom = _row(a, library, "tom_high_right_hand")
+    assert len(crossing(left, [hihat])) == 1
+    assert crossing(left, [tom]) == []

@@ -127,6 +127,10 @@ _DEPART_M = 0.02
 # the left under the right stick crossed over it (DrummerHands._under): right strokes
 # from this long before the left's impact (or its last impact, if later) to its next
 _UNDER_BEFORE_S = 0.25
+# ... and those up to drummer_clear.BEFORE_IMPACT_S after its impact when its next
+# backswing lifts the tip at most this (m): a low stroke ("tap", drum method books' 2-6
+# inches) barely raises the butt, which turns down as the tip goes up
+_UNDER_LIFT_M = 0.1
 
 
 @dataclass(frozen=True)
@@ -673,26 +677,13 @@ class DrummerHands:
         rise = min(2 * down + 0.05, 0.5 * gap)
         return gap - down - rise > min(s.rebound_max_s, s.rebound_share * gap) + 1e-4
 
-    def _under(
-        self, hand: str, t: float, span: tuple[float, float], waits: bool, row: np.ndarray
-    ) -> np.ndarray:
-        """``row`` (the impact pose of a left-hand stroke at ``t``) lowered under the right
-        stick crossed over it (:func:`drummer_landing.under`) where the right strikes
-        within ``span`` (from the left's last impact or _UNDER_BEFORE_S before this one,
-        to its next): all of them when the left ``waits`` there (hovers before its next
-        stroke); else only those up to ``t``, and not at all when one after ``t`` crosses
-        it (the left's rebound rises straight into its next backswing, which would come
-        up through that stick: the louder goes over then, :meth:`_over`).  A left coming
-        up from the snare to the high tom under the right stick leaving the hi-hat 100
-        ms before: GMD merengue 130 at 18.0 s."""
+    def _under(self, hand: str, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
+        """``row`` (the impact pose of a left-hand stroke) lowered under the right stick
+        crossed over it (:func:`drummer_landing.under`) where the right strikes within
+        ``span`` (:meth:`_build` says which: while the left is low there)."""
         if hand != HANDS[0]:
             return row
         others = [r for r, _v, _a in self._others(hand, span[0], span[1], up_to=False)]
-        if not waits:
-            later = [r for r, _v, _a in self._others(hand, t, span[1], up_to=False)]
-            if drummer_landing.crossing(row, later):
-                return row
-            others = others[: len(others) - len(later)]
         return drummer_landing.under(self._arm[hand], row, others, self.settings.reach_max_m)
 
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
@@ -789,9 +780,23 @@ class DrummerHands:
             nxt_t = next((u for u in times[i + 1 :] if u - t >= 1e-6), math.inf)
             since = t - _UNDER_BEFORE_S if prev_t is None else max(prev_t, t - _UNDER_BEFORE_S)
             until = min(nxt_t, t + 0.5 * s.rest_after_s)  # then it rests
-            target = self._under(
-                hand, t, (since, until), nxt_t == math.inf or self._waits(nxt_t - t), row
-            )
+            # the left goes under the right stick crossed over it where the right strikes
+            # while the left is low there: from its last impact (or _UNDER_BEFORE_S before
+            # this one) to its next, where it waits (hovers before the next backswing);
+            # else up to its impact (the rebound goes on into the next backswing: GMD
+            # merengue 130 at 18.0 s, the left coming up from the snare to the high tom
+            # 100 ms after the right struck the hi-hat), and up to BEFORE_IMPACT_S after
+            # it when that backswing is low (at most _UNDER_LIFT_M: GMD funk 112 fill at
+            # 2.43 s, the left's loud tom 15 ms before the right's hi-hat, then down to a
+            # soft snare; a loud one rises from over the right stick, :meth:`_over`)
+            if nxt_t == math.inf or self._waits(nxt_t - t):
+                end = until
+            else:
+                j = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
+                _s, _p, vel_n, art_n = strokes[j]
+                low = self._lift_for(vel_n, nxt_t - t, art_n) <= _UNDER_LIFT_M
+                end = t + drummer_clear.BEFORE_IMPACT_S + 1e-9 if low else t
+            target = self._under(hand, (since, end), row)
             if target is row:
                 target = self._over(hand, t, row)
             if base is not None:

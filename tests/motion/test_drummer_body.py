@@ -158,6 +158,16 @@ def test_still_before_the_first_stroke(library: MotionLibrary) -> None:
     assert np.ptp(_chest_yaw(a, np.arange(9.5, 12.0, 0.05))) > 0.5
 
 
+def test_the_feet_alone_wake_the_body(library: MotionLibrary) -> None:
+    """GMD rock 118 (drummer7 session2 take 22): three hi-hat pedal chicks and nothing
+    else; the body woke only for a hand's stroke, so the drummer sat still (torso 0)."""
+    a = BandAnimator(library)
+    for k in range(4):
+        a.add_beat(Beat(1.0 + 0.5 * k, 0, k + 1, 4, 0, 500_000))
+        a.add_planned(drum("hihat_left_foot", 0.85 + 0.5 * k, 1.0 + 0.5 * k))
+    assert np.ptp(_chest_yaw(a, np.arange(1.0, 3.0, 0.02))) > 3.0
+
+
 def test_the_right_foot_feathers_the_kick_on_beats_without_a_kick(
     library: MotionLibrary,
 ) -> None:

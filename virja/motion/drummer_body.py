@@ -26,8 +26,8 @@ stay where the clips put them:
   the body's sway about the spine (not its turn toward the pieces, which would
   carry it into the other stick): it sways instead of hanging frozen in space.
 
-Before the first hand stroke the drummer sits still (the body wakes over the
-``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals; only the right
+Before his first stroke (of any limb) the drummer sits still (the body wakes
+over the ``engage_s`` before it).  The hips and legs are not moved (the feet stay on the pedals; only the right
 ankle feathers).  Constants:
 motions/drummer_body.toml.  Everything is vectorised over times.
 """
@@ -35,6 +35,7 @@ motions/drummer_body.toml.  Everything is vectorised over times.
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -122,9 +123,12 @@ class DrummerBody:
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
         self._az: dict[str, list[float]] = {h: [] for h in HANDS}
         self._kicks: list[float] = []  # the right foot's strokes (no feathering near them)
+        self._first = math.inf  # the first stroke of any limb: the body wakes for it
 
     def add_stroke(self, limb: str, impact: float, piece: str | None) -> None:
-        """Record a hand's stroke or a kick (the other foot and unknown pieces are ignored)."""
+        """Record a hand's stroke or a kick (the hi-hat pedal and unknown pieces only
+        wake the body: GMD rock 118, three pedal chicks and nothing else, sat still)."""
+        self._first = min(self._first, impact)
         if limb == "right_foot":
             bisect.insort(self._kicks, impact)
             return
@@ -271,10 +275,9 @@ class DrummerBody:
         if s.is_still:
             return out
         # before his first stroke the drummer sits still; the body wakes over the second before it
-        firsts = [h[0] for h in self._times.values() if h]
-        if not firsts:
+        if self._first == math.inf:
             return out
-        awake = np.clip(t - (min(firsts) - s.engage_s), 0.0, s.engage_s) / s.engage_s
+        awake = np.clip(t - (self._first - s.engage_s), 0.0, s.engage_s) / s.engage_s
         yaw = awake * (self.turn(t) + self._sway(t, beat_times, beat_spb))
         breath = awake * np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
         lean = awake * self._lean(t, beat_times, beat_spb)

@@ -130,7 +130,7 @@ _UNDER_BEFORE_S = 0.25
 # ... and those up to drummer_clear.BEFORE_IMPACT_S after its impact when its next
 # backswing lifts the tip at most this (m): a low stroke ("tap", drum method books' 2-6
 # inches) barely raises the butt, which turns down as the tip goes up
-_UNDER_LIFT_M = 0.1
+_UNDER_LIFT_M = 0.15
 
 
 @dataclass(frozen=True)
@@ -795,7 +795,7 @@ class DrummerHands:
                 j = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
                 _s, _p, vel_n, art_n = strokes[j]
                 low = self._lift_for(vel_n, nxt_t - t, art_n) <= _UNDER_LIFT_M
-                end = t + drummer_clear.BEFORE_IMPACT_S + 1e-9 if low else t
+                end = until if low else t
             target = self._under(hand, (since, end), row)
             if target is row:
                 target = self._over(hand, t, row)

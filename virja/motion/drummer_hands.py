@@ -127,9 +127,11 @@ _DEPART_M = 0.02
 # the left under the right stick crossed over it (DrummerHands._under): right strokes
 # from this long before the left's impact (or its last impact, if later) to its next
 _UNDER_BEFORE_S = 0.25
-# ... and those up to drummer_clear.BEFORE_IMPACT_S after its impact when its next
-# backswing lifts the tip at most this (m): a low stroke ("tap", drum method books' 2-6
-# inches) barely raises the butt, which turns down as the tip goes up
+# ... and those after its impact when its next backswing lifts the tip at most this (m):
+# the stick turns up about the wrist (wrist_share of it raises the wrist), so a low or
+# middle stroke barely raises the hand where the right stick crosses the left (GMD funk
+# 112 fill at 2.43 s, rock-prog 125 at 21.0 s); a full stroke (velocity 121: 28 cm)
+# raises it 8 cm
 _UNDER_LIFT_M = 0.15
 
 
@@ -782,20 +784,18 @@ class DrummerHands:
             until = min(nxt_t, t + 0.5 * s.rest_after_s)  # then it rests
             # the left goes under the right stick crossed over it where the right strikes
             # while the left is low there: from its last impact (or _UNDER_BEFORE_S before
-            # this one) to its next, where it waits (hovers before the next backswing);
-            # else up to its impact (the rebound goes on into the next backswing: GMD
-            # merengue 130 at 18.0 s, the left coming up from the snare to the high tom
-            # 100 ms after the right struck the hi-hat), and up to BEFORE_IMPACT_S after
-            # it when that backswing is low (at most _UNDER_LIFT_M: GMD funk 112 fill at
-            # 2.43 s, the left's loud tom 15 ms before the right's hi-hat, then down to a
-            # soft snare; a loud one rises from over the right stick, :meth:`_over`)
-            if nxt_t == math.inf or self._waits(nxt_t - t):
-                end = until
-            else:
-                j = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
-                _s, _p, vel_n, art_n = strokes[j]
-                low = self._lift_for(vel_n, nxt_t - t, art_n) <= _UNDER_LIFT_M
-                end = until if low else t
+            # this one) to its next where it waits (hovers before the next backswing) or
+            # that backswing is low (at most _UNDER_LIFT_M); else up to its impact (the
+            # rebound goes on into a high backswing: GMD merengue 130 at 18.0 s, the left
+            # coming up from the snare to the high tom 100 ms after the right struck the
+            # hi-hat; a loud stroke right after the right's rises from over its stick,
+            # :meth:`_over`, New Orleans funk 84 fill)
+            end = until
+            if nxt_t < math.inf and not self._waits(nxt_t - t):
+                n = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
+                _s, _p, vel_n, art_n = strokes[n]
+                if self._lift_for(vel_n, nxt_t - t, art_n) > _UNDER_LIFT_M:
+                    end = t
             target = self._under(hand, (since, end), row)
             if target is row:
                 target = self._over(hand, t, row)

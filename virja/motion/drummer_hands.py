@@ -679,14 +679,18 @@ class DrummerHands:
         rise = min(2 * down + 0.05, 0.5 * gap)
         return gap - down - rise > min(s.rebound_max_s, s.rebound_share * gap) + 1e-4
 
-    def _under(self, hand: str, span: tuple[float, float], row: np.ndarray) -> np.ndarray:
+    def _under(
+        self, hand: str, span: tuple[float, float], row: np.ndarray, lift: float
+    ) -> np.ndarray:
         """``row`` (the impact pose of a left-hand stroke) lowered under the right stick
         crossed over it (:func:`drummer_landing.under`) where the right strikes within
         ``span`` (:meth:`_build` says which: while the left is low there)."""
         if hand != HANDS[0]:
             return row
         others = [r for r, _v, _a in self._others(hand, span[0], span[1], up_to=False)]
-        return drummer_landing.under(self._arm[hand], row, others, self.settings.reach_max_m)
+        s = self.settings
+        extra = s.wrist_share * lift  # the wrist's own rise in the backswing
+        return drummer_landing.under(self._arm[hand], row, others, s.reach_max_m, extra)
 
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
         """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
@@ -796,7 +800,8 @@ class DrummerHands:
                 _s, _p, vel_n, art_n = strokes[n]
                 if self._lift_for(vel_n, nxt_t - t, art_n) > _UNDER_LIFT_M:
                     end = t
-            target = self._under(hand, (since, end), row)
+            gap_here = math.inf if prev_t is None else t - prev_t
+            target = self._under(hand, (since, end), row, self._lift_for(vel, gap_here, art))
             if target is row:
                 target = self._over(hand, t, row)
             if base is not None:

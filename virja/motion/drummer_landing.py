@@ -211,34 +211,41 @@ def crossing(row: np.ndarray, others: Sequence[np.ndarray]) -> list[np.ndarray]:
     ]
 
 
-def under(arm: Arm, row: np.ndarray, others: Sequence[np.ndarray], max_m: float) -> np.ndarray:
+def under(
+    arm: Arm, row: np.ndarray, others: Sequence[np.ndarray], max_m: float, extra_m: float = 0.0
+) -> np.ndarray:
     """``row`` (the impact pose of a left-hand stroke) with the wrist lowered, turned
     about the tip, until its stick lies ``STICK_CLEAR_M`` under each of ``others`` (the
-    right's impact rows while the left waits there) that crosses it seen from above
-    and passes within ``UNDER_NEAR_M`` of it: the right arm crossed over onto the
-    hi-hat, the left plays the drums beneath it.  In ``STEP_M`` steps, at most
-    ``max_m``; the unchanged ``row`` where that is not enough (GMD latin-chacarera 118
-    at 8.12 s: the left on the high tom, its butt at the height of the right stick,
-    which rose into it with each hi-hat stroke while the left waited there)."""
+    right's impact rows while the left is low there) that crosses it (:func:`crossing`):
+    the right arm crossed over onto the hi-hat, the left plays the drums beneath it.
+    In ``STEP_M`` steps, at most ``max_m``; the unchanged ``row`` where that is not
+    enough (GMD latin-chacarera 118 at 8.12 s: the left on the high tom, its butt at the
+    height of the right stick, which rose into it with each hi-hat stroke while the left
+    waited there).  Then, as far as ``max_m`` allows, ``extra_m`` lower still (the
+    wrist's own rise in the stroke's backswing, which comes up under the right stick:
+    GMD calypso 108 at 17.8 s)."""
     near = crossing(row, others)
     if not near:
         return row
 
-    def beneath(r: np.ndarray) -> bool:
+    def beneath(r: np.ndarray, clear: float) -> bool:
         for other in near:
             d, ya, yb = _closest(r, other)
-            if ya >= yb or d < drummer_clear.STICK_CLEAR_M:
+            if ya >= yb or d < clear:
                 return False
         return True
 
-    if beneath(row):
+    if beneath(row, drummer_clear.STICK_CLEAR_M + extra_m):
         return row
     wrist = arm.wrist(row)
+    found = row
     for k in range(1, 1 + int(max_m / STEP_M + 1e-9)):
         down = arm.reach(row, wrist - _UP, k * STEP_M)
-        if beneath(down):
+        if found is row and beneath(down, drummer_clear.STICK_CLEAR_M):
+            found = down
+        if found is not row and beneath(down, drummer_clear.STICK_CLEAR_M + extra_m):
             return down
-    return row
+    return found
 
 
 __all__ = ["Arm", "crosses_over", "crossing", "over", "reached", "stick_ends", "tip", "under"]

@@ -127,12 +127,13 @@ _DEPART_M = 0.02
 # the left under the right stick crossed over it (DrummerHands._under): right strokes
 # from this long before the left's impact (or its last impact, if later) to its next
 _UNDER_BEFORE_S = 0.25
-# ... and those after its impact when its next backswing lifts the tip at most this (m):
-# the stick turns up about the wrist (wrist_share of it raises the wrist), so a low or
-# middle stroke barely raises the hand where the right stick crosses the left (GMD funk
-# 112 fill at 2.43 s, rock-prog 125 at 21.0 s); a full stroke (velocity 121: 28 cm)
-# raises it 8 cm
-_UNDER_LIFT_M = 0.15
+# ... and those after its impact when its next backswing lifts the tip at most this (m),
+# the hand lowered further by that backswing's wrist rise (wrist_share of it; at most
+# reach_max_m in all): a middle stroke (drum method books' full stroke is 30 cm) rises
+# under the right stick (GMD funk 112 fill at 2.43 s, rock-prog 125 at 21.0 s, funk
+# purdie shuffle 130 fill at 1.16 s); a full one (velocity 121: 28 cm, the wrist 8 cm)
+# from over it (:meth:`_over`, New Orleans funk 84 fill)
+_UNDER_LIFT_M = 0.2
 
 
 @dataclass(frozen=True)
@@ -795,13 +796,15 @@ class DrummerHands:
             # hi-hat; a loud stroke right after the right's rises from over its stick,
             # :meth:`_over`, New Orleans funk 84 fill)
             end = until
+            lift_in = self._lift_for(vel, math.inf if prev_t is None else t - prev_t, art)
+            lift_on = 0.0  # the next backswing's, where the right strokes after it count
             if nxt_t < math.inf and not self._waits(nxt_t - t):
                 n = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
                 _s, _p, vel_n, art_n = strokes[n]
-                if self._lift_for(vel_n, nxt_t - t, art_n) > _UNDER_LIFT_M:
-                    end = t
-            gap_here = math.inf if prev_t is None else t - prev_t
-            target = self._under(hand, (since, end), row, self._lift_for(vel, gap_here, art))
+                lift_on = self._lift_for(vel_n, nxt_t - t, art_n)
+                if lift_on > _UNDER_LIFT_M:
+                    end, lift_on = t, 0.0
+            target = self._under(hand, (since, end), row, max(lift_in, lift_on))
             if target is row:
                 target = self._over(hand, t, row)
             if base is not None:

@@ -336,14 +336,18 @@ def test_no_detour_keeping_the_sticks_18_mm_apart_the_farthest_is_made() -> None
         # then down to a soft snare (2.546 s): raised over the right stick as the louder,
         # it came down through it
         ("drummer7_session3_62_funk_112_fill_4-4.mid", 3.5),
+        # the left's tom strokes 103 ms apart (1.160, 1.263 s) around the right's soft
+        # hi-hat (1.174 s): raised over the right stick at the first (the louder of two
+        # strokes 14 ms apart), lowered under it at the second, through it between
+        ("drummer1_session1_256_funk-purdieshuffle_130_fill_4-4.mid", 2.0),
     ],
 )
 def test_a_left_low_under_the_crossed_right_stick_around_its_impact_stays_under(
     name: str, seconds: float
 ) -> None:
-    """GMD hip-hop 100 (drummer7 session1 take 17) and funk 112 fill (drummer7 session3
-    take 62): both strokes inside each other's guards, stick-stick 3 and 1 on main
-    0c40dbc.  The left now lands under the right stick where the right strikes before
+    """GMD hip-hop 100 (drummer7 session1 take 17), funk 112 fill (drummer7 session3
+    take 62) and funk purdie shuffle 130 fill (drummer1 session1 take 256): the strokes
+    inside each other's guards, stick-stick 3, 1 and 2 on main 0c40dbc.  The left now lands under the right stick where the right strikes before
     its impact, or just after it when its own next backswing is low."""
     _meets_targets(_report(GMD / name, seconds, False))
 

@@ -101,3 +101,16 @@ def test_a_right_stroke_on_the_left_s_own_tom_does_not_cross_it(library: MotionL
     tom = _row(a, library, "tom_high_right_hand")
     assert len(crossing(left, [hihat])) == 1
     assert crossing(left, [tom]) == []
+
+
+def test_under_goes_lower_by_the_wrist_s_rise_as_far_as_the_reach_allows(
+    library: MotionLibrary,
+) -> None:
+    l_arm, _r_arm, left, right = _setup(library)
+    base = under(l_arm, left, [right], 0.12)
+    deeper = under(l_arm, left, [right], 0.12, extra_m=0.03)
+    assert l_arm.wrist(deeper)[1] < l_arm.wrist(base)[1] - 0.02
+    assert _apart(deeper, right)[0] >= drummer_clear.STICK_CLEAR_M + 0.03 - 1e-9
+    assert np.allclose(tip(deeper), tip(left), atol=1e-9)
+    # more than the reach: the least that clears the stick, not nothing
+    assert under(l_arm, left, [right], 0.12, extra_m=1.0) is not left

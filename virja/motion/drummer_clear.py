@@ -521,22 +521,24 @@ def detours_in(
         gap = pa - pb
         d = np.linalg.norm(gap, axis=1)
         # each detour is found on the samples as they were before this pass: one whose
-        # window overlaps another made in this pass is left to the next pass, which sees
-        # that one (two pull-backs of 15 cm for two runs 60 ms apart added up to 30 cm,
-        # ramped out in 75 ms: a 16 cm jump at 30 fps, GMD rock 140 at 26.5 s)
-        busy: list[tuple[float, float]] = []
+        # window overlaps another of the same hand made in this pass is left to the next
+        # pass, which sees that one (two pull-backs of 15 cm for two runs 60 ms apart
+        # added up to 30 cm, ramped out in 75 ms: a 16 cm jump at 30 fps, GMD rock 140
+        # at 26.5 s).  The other hand's may overlap: a run whose detour reaches only
+        # STICK_APART_M stays under STICK_TRIGGER_M and is found again each pass, and
+        # deferred behind it, the left's pull-back for the crossing 80 ms on was never
+        # made (GMD rock 135 at 16.34 s)
+        busy: list[list[tuple[float, float]]] = [[], []]
         for i, j in _runs(d < STICK_CLEAR_M):
             if d[i : j + 1].min() < STICK_TRIGGER_M:
-                if any(a <= float(t[j]) and float(t[i]) <= b for a, b in busy):
-                    continue
                 found = _apart_detour(t, (left, right), gap, (i, j), impacts, sampled.kit, floor)
                 if not found or any(
-                    a <= made.t3 and made.t0 <= b for _h, made in found for a, b in busy
+                    a <= made.t3 and made.t0 <= b for h, made in found for a, b in busy[h]
                 ):
                     continue
                 for h, made in found:
                     out[h].append(made)
-                    busy.append((made.t0, made.t3))
+                    busy[h].append((made.t0, made.t3))
     for h, heights in enumerate(sampled.heights):
         for hgt, inside in heights:
             for i, j in _runs(inside & (hgt < -SURFACE_TRIGGER_M)):

@@ -34,9 +34,10 @@ hand's rotation and the elbow at the impact frame, exact on the instrument):
   other (no detour bends a track there), the louder stroke's hand lands raised over
   the other stick (:func:`virja.motion.drummer_landing.over`), and a squeezed move up
   to a stroke that ends crossed over the other stick gets its height first
-  (``_SQUEEZED_OVER``).  A left hand that waits on a drum (hovers before its next
-  stroke) under the right stick crossed over it onto the hi-hat lands lowered under
-  that stick instead (:func:`virja.motion.drummer_landing.under`).
+  (``_SQUEEZED_OVER``).  A left hand playing a drum under the right stick crossed
+  over it onto the hi-hat lands lowered under that stick, lower still by its wrist's
+  rise in the backswing, wherever the right strikes while the left is low there
+  (:func:`virja.motion.drummer_landing.under`; which strokes count: :meth:`_build`).
 - **apart**: the two hands' tracks are sampled together and bent around each
   other and the kit where a stick would go through the other or a tip under a
   piece (:mod:`virja.motion.drummer_clear`, :meth:`DrummerHands._clear`).

@@ -135,6 +135,8 @@ def test_velocity_weighs_in_the_priority() -> None:
 
 
 GMD_FILES = sorted(GMD.glob("*.mid"))
+# the Roland TD-11's own pitches in the Groove MIDI Dataset (edges, rims, bell)
+TD11_PITCHES = frozenset({22, 26, 40, 47, 50, 52, 53, 55, 58, 59})
 
 
 @pytest.mark.parametrize("path", GMD_FILES, ids=[p.stem for p in GMD_FILES])
@@ -149,7 +151,21 @@ def test_groove_midi_dataset_takes_drop_no_kit_note(path: Path) -> None:
     assert Counter(d.reason for d in report.dropped) == Counter()
     assert not any(p.late for p in planned)
     assert len(planned) == sum(1 for w, _ in notes if w == "drums")
-    assert {p.note for p in planned} & {22, 26, 40, 47, 50, 52, 53, 55, 58, 59}
+    used = {e.note for w, e in notes if w == "drums"} & TD11_PITCHES
+    assert {p.note for p in planned} & TD11_PITCHES == used  # each one the take has
+
+
+def test_the_gmd_sample_has_the_td11_s_own_pitches() -> None:
+    """The sample above plays the TD-11's own pitches (edges, rims, bell); a take of
+    General MIDI pitches alone (funk purdie shuffle 130 fill) is in it for its motion."""
+    pitches: set[int] = set()
+    with_td = 0
+    for path in GMD_FILES:
+        got = {e.note for e in read_midi(path).events if isinstance(e, NoteOn)}
+        pitches |= got
+        with_td += bool(got & TD11_PITCHES)
+    assert pitches >= TD11_PITCHES
+    assert with_td >= len(GMD_FILES) - 1
 
 
 def test_crash_2_notes_are_played_on_crash_2_by_the_right_hand() -> None:

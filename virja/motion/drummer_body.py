@@ -278,7 +278,8 @@ class DrummerBody:
         if self._first == math.inf:
             return out
         awake = np.clip(t - (self._first - s.engage_s), 0.0, s.engage_s) / s.engage_s
-        yaw = awake * (self.turn(t) + self._sway(t, beat_times, beat_spb))
+        sway = awake * self._sway(t, beat_times, beat_spb)  # a resting hand rides with it
+        yaw = awake * self.turn(t) + sway
         breath = awake * np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
         lean = awake * self._lean(t, beat_times, beat_spb)
         hips = out[:, _HIPS]
@@ -306,7 +307,6 @@ class DrummerBody:
         # gone to rest drifted 12 cm from where its track put it, into the other stick
         # hovering over the snare (MMA jazzcombo 60 at 12.5 s, the right resting while
         # the left waits on the snare)
-        sway = awake * self._sway(t, beat_times, beat_spb)
         for hand in HANDS:
             c = self.engagement(hand, t)
             rows = np.flatnonzero((awake > 0.0) | (c > 0.0))

@@ -187,13 +187,16 @@ def crosses_over(row: np.ndarray, others: Sequence[np.ndarray]) -> bool:
     return False
 
 
-def _behind(row: np.ndarray, other: np.ndarray) -> bool:
-    """Whether the stick of ``other`` crosses the stick of ``row``, seen from above,
-    behind its middle (toward the hand, not where two tips meet on one piece)."""
+def _crossed_behind(row: np.ndarray, other: np.ndarray) -> bool:
+    """Whether the stick of ``other`` crosses the stick of ``row`` seen from above
+    (under ``STICK_CLEAR_M``) behind its middle (toward the hand, not where two tips
+    meet on one piece)."""
     a0, a1 = (e[None] * _FLAT for e in stick_ends(row))
     b0, b1 = (e[None] * _FLAT for e in stick_ends(other))
-    pa, _pb = drummer_clear.segment_closest(a0, a1, b0, b1)
-    return float(np.linalg.norm(pa - a0)) < 0.5 * float(np.linalg.norm(a1 - a0))
+    pa, pb = drummer_clear.segment_closest(a0, a1, b0, b1)
+    return float(np.linalg.norm(pa - pb)) < drummer_clear.STICK_CLEAR_M and float(
+        np.linalg.norm(pa - a0)
+    ) < 0.5 * float(np.linalg.norm(a1 - a0))
 
 
 def crossing(row: np.ndarray, others: Sequence[np.ndarray]) -> list[np.ndarray]:
@@ -205,9 +208,7 @@ def crossing(row: np.ndarray, others: Sequence[np.ndarray]) -> list[np.ndarray]:
     return [
         other
         for other in others
-        if _closest(row, other, flat=True)[0] < drummer_clear.STICK_CLEAR_M
-        and _behind(row, other)
-        and _closest(row, other)[0] < UNDER_NEAR_M
+        if _crossed_behind(row, other) and _closest(row, other)[0] < UNDER_NEAR_M
     ]
 
 

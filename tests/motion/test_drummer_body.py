@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import json
+from contextlib import redirect_stderr, redirect_stdout
+from io import StringIO
+from pathlib import Path
+
 import numpy as np
 
 from tests.motion.helpers import drum
 from virja.events import Beat
+from virja.cli.main import main
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary
 from virja.motion.drummer_body import BodySettings
@@ -194,3 +200,35 @@ def test_the_right_foot_feathers_the_kick_on_beats_without_a_kick(
     np.testing.assert_allclose(feathered[:4], flat[:4], atol=1e-9)  # near the kick
     assert feathered[4] < flat[4] - 0.005  # pressed on a free beat
     assert abs(feathered[5] - flat[5]) < 1e-9  # and back between beats
+
+
+def test_the_turn_follows_the_hands_over_two_beats(library: MotionLibrary) -> None:
+    """The turn's window is two beats (0.5-0.9 s): at 130 bpm a left hand going snare,
+    hi-hat, snare every two beats (GMD drummer2 rock 130) turned the chest back and
+    forth against the beat's sway over a 0.5 s window; over two beats it barely turns."""
+    a = BandAnimator(library)
+    body = a.body
+    assert np.allclose(body.smoothing(np.array([0.2, 0.3, 60 / 130, 1.0])), [0.5, 0.6, 0.9, 0.9])
+    spb = 60 / 130
+    for k in range(12):
+        t = 1.0 + k * spb
+        a.add_planned(drum("ride_right_hand", t - 0.2, t))
+        left = "hihat" if k % 2 else "snare"
+        a.add_planned(drum(f"{left}_left_hand", t + spb / 2 - 0.2, t + spb / 2))
+    times = np.arange(3.0, 6.0, 1 / 120)
+    fixed = np.ptp(body.turn(times, 0.25))  # a 0.5 s window
+    beats = np.ptp(body.turn(times, spb))
+    assert np.degrees(fixed) > 1.5
+    assert beats < 0.3 * fixed
+
+
+def test_a_short_rock_groove_turns_the_chest_3_degrees() -> None:
+    """GMD drummer2 session2 take 10 (rock, 130 bpm, 17 notes in 1.8 s): its chest
+    turned 2.9 degrees on main 36cbd24, the turn toward the hi-hat against the beat's
+    sway; issue 15's target is 3 or more."""
+    path = Path(__file__).resolve().parent.parent / "data" / "gmd"
+    out = StringIO()
+    argv = ["motion-report", str(path / "drummer2_session2_10_rock_130_beat_4-4.mid"), "--json"]
+    with redirect_stdout(out), redirect_stderr(StringIO()):
+        assert main(argv) == 0
+    assert json.loads(out.getvalue())["drums"]["torso_range_deg"] >= 3.0

@@ -7,8 +7,10 @@ stay where the clips put them:
 - **turn**: the spine and chest turn (yaw) toward the pieces the two hands
   play: a step function of time (at each stroke's impact the hand's piece
   changes) averaged over both hands, scaled by ``gain`` and clamped, then
-  smoothed by a centred moving average (so the turn starts before the stroke
-  and never jumps).
+  smoothed by a centred moving average over two beats (``smooth_beats``,
+  clamped to ``smooth_min_s``-``smooth_max_s``), so the turn starts before the
+  stroke, never jumps, and follows where the hands play over the bar, not each
+  stroke.
 - **breathing**: the chest pitches slowly (``breath_deg`` at ``breath_period_s``).
 - **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
   ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
@@ -68,7 +70,9 @@ class BodySettings:
 
     gain: float = 0.45
     max_turn_deg: float = 12.0
-    smooth_s: float = 0.5
+    smooth_beats: float = 2.0
+    smooth_min_s: float = 0.5
+    smooth_max_s: float = 0.9
     chest_share: float = 0.5
     head_share: float = 0.5
     breath_deg: float = 0.8
@@ -165,11 +169,20 @@ class DrummerBody:
         lim = np.radians(s.max_turn_deg)
         return np.asarray(np.clip(s.gain * mean, -lim, lim))
 
-    def turn(self, t: np.ndarray) -> np.ndarray:
+    def smoothing(self, spb: np.ndarray | float) -> np.ndarray:
+        """The turn's window (s) where a beat lasts ``spb`` s: ``smooth_beats`` beats,
+        clamped to ``smooth_min_s``-``smooth_max_s``."""
+        s = self.settings
+        return np.asarray(np.clip(s.smooth_beats * np.asarray(spb), s.smooth_min_s, s.smooth_max_s))
+
+    def turn(self, t: np.ndarray, spb: np.ndarray | float | None = None) -> np.ndarray:
         """The torso's yaw (rad) at times ``t``: the target's exact moving average over
-        ``smooth_s`` (the target is a step function, so the turn is piecewise linear)."""
+        :meth:`smoothing` of ``spb`` (each time's seconds per beat; ``reference_spb``
+        where not given).  The target is a step function, so the turn is piecewise
+        linear (where the tempo holds)."""
         t = np.asarray(t, dtype=np.float64)
-        half = self.settings.smooth_s / 2
+        spb = self.settings.reference_spb if spb is None else spb
+        half = np.broadcast_to(self.smoothing(spb) / 2, t.shape)
         # sorted, each once (np.unique's first call imports numpy.ma: 16 ms in a render's
         # first chunk; docs/performance.md, "Pose and scene, eighth round")
         steps = np.sort(
@@ -178,8 +191,8 @@ class DrummerBody:
         steps = steps[np.concatenate([[True], steps[1:] != steps[:-1]])] if steps.size else steps
         if steps.size == 0 or t.size == 0:
             return np.asarray(self._target(t))
-        lo = min(float(t.min()) - half, float(steps[0])) - 1.0
-        hi = max(float(t.max()) + half, float(steps[-1])) + 1.0
+        lo = min(float((t - half).min()), float(steps[0])) - 1.0
+        hi = max(float((t + half).max()), float(steps[-1])) + 1.0
         knots = np.concatenate([[lo], steps, [hi]])
         values = self._target((knots[:-1] + knots[1:]) / 2)  # the target on each interval
         integral = np.concatenate([[0.0], np.cumsum(values * np.diff(knots))])
@@ -220,15 +233,19 @@ class DrummerBody:
 
     def _lean(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
         """Forward lean (rad) on each beat."""
+        return self._lean_of(*self._beat_phase(t, beat_times, beat_spb))
+
+    def _lean_of(self, phase: np.ndarray, spb: np.ndarray, _sign: np.ndarray) -> np.ndarray:
         s = self.settings
-        phase, spb, _sign = self._beat_phase(t, beat_times, beat_spb)
         amp = np.radians(s.beat_deg) * np.clip(spb / s.reference_spb, 0.3, 1.5)
         return np.asarray(amp * np.sin(np.pi * phase) ** 2)
 
     def _sway(self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray) -> np.ndarray:
         """Side-to-side turn (rad) with the beat: one way on one beat, the other on the next."""
+        return self._sway_of(*self._beat_phase(t, beat_times, beat_spb))
+
+    def _sway_of(self, phase: np.ndarray, spb: np.ndarray, sign: np.ndarray) -> np.ndarray:
         s = self.settings
-        phase, spb, sign = self._beat_phase(t, beat_times, beat_spb)
         amp = np.radians(s.sway_deg) * np.clip(spb / s.reference_spb, s.sway_floor, s.sway_ceiling)
         return np.asarray(sign * amp * np.sin(np.pi * phase) ** 2)
 
@@ -278,10 +295,11 @@ class DrummerBody:
         if self._first == math.inf:
             return out
         awake = np.clip(t - (self._first - s.engage_s), 0.0, s.engage_s) / s.engage_s
-        sway = awake * self._sway(t, beat_times, beat_spb)  # a resting hand rides with it
-        yaw = awake * self.turn(t) + sway
+        beat = self._beat_phase(t, beat_times, beat_spb)  # (phase, spb, sign)
+        sway = awake * self._sway_of(*beat)  # a resting hand rides with it
+        yaw = awake * self.turn(t, beat[1]) + sway
         breath = awake * np.radians(s.breath_deg) * np.sin(2 * np.pi * t / s.breath_period_s)
-        lean = awake * self._lean(t, beat_times, beat_spb)
+        lean = awake * self._lean_of(*beat)
         hips = out[:, _HIPS]
         spine_turn = quat.from_axis_angle(_UP, yaw * (1.0 - s.chest_share))
         chest_turn = quat.from_axis_angle(_UP, yaw * s.chest_share)

@@ -694,6 +694,14 @@ class DrummerHands:
         extra = s.wrist_share * lift  # the wrist's own rise in the backswing
         return drummer_landing.under(self._arm[hand], row, others, s.reach_max_m, extra)
 
+    def _low(self, hand: str, span: tuple[float, float], row: np.ndarray) -> bool:
+        """Whether the right stick crosses over ``row`` (a left-hand impact pose) at a
+        right stroke within ``span`` (:func:`drummer_landing.crossing`)."""
+        if hand != HANDS[0]:
+            return False
+        others = [r for r, _v, _a in self._others(hand, span[0], span[1], up_to=False)]
+        return bool(drummer_landing.crossing(row, others))
+
     def _crosses_over(self, hand: str, t: float, row: np.ndarray) -> bool:
         """Whether ``hand``'s stick at its impact at ``t`` (pose ``row``) lies over the
         other hand's stick, crossed seen from above (under ``STICK_CLEAR_M``), at an
@@ -798,6 +806,9 @@ class DrummerHands:
             # :meth:`_over`, New Orleans funk 84 fill)
             end = until
             lift_in = self._lift_for(vel, math.inf if prev_t is None else t - prev_t, art)
+            low = self._low(hand, (since, t), row)
+            if low:
+                lift_in = min(lift_in, _UNDER_LIFT_M)
             lift_on = 0.0  # the next backswing's, where the right strokes after it count
             if nxt_t < math.inf and not self._waits(nxt_t - t):
                 n = next(k for k in range(i + 1, len(times)) if times[k] - t >= 1e-6)
@@ -826,6 +837,8 @@ class DrummerHands:
             # it learnt of this one when that is later (a hand the plan gives a note at
             # the motion's start, live, has the lead from where it is, not the gap)
             lift = self._lift_for(vel, min(gap, room), art)
+            if low:
+                lift = min(lift, _UNDER_LIFT_M)
             # a far move with little time: the stick takes part of it (_reached); at this
             # impact the wrist still sits toward where it comes from ...
             target = self._reached(hand, target, here, room, 1.0)

@@ -124,7 +124,9 @@ def animation_settings(path: Path) -> AnimationSettings:
 class TurnTable(Schema):
     gain: float
     max_deg: float
-    smooth_s: float
+    smooth_beats: float
+    smooth_min_s: float
+    smooth_max_s: float
     chest_share: float
     head_share: float
 
@@ -167,7 +169,9 @@ def body_settings(path: Path) -> BodySettings:
     return BodySettings(
         gain=f.turn.gain,
         max_turn_deg=f.turn.max_deg,
-        smooth_s=f.turn.smooth_s,
+        smooth_beats=f.turn.smooth_beats,
+        smooth_min_s=f.turn.smooth_min_s,
+        smooth_max_s=f.turn.smooth_max_s,
         chest_share=f.turn.chest_share,
         head_share=f.turn.head_share,
         breath_deg=f.breath.chest_deg,

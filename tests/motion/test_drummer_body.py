@@ -8,10 +8,11 @@ from io import StringIO
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from tests.motion.helpers import drum
-from virja.events import Beat
 from virja.cli.main import main
+from virja.events import Beat
 from virja.motion.band import BandAnimator
 from virja.motion.clip import MotionLibrary
 from virja.motion.drummer_body import BodySettings
@@ -202,24 +203,73 @@ def test_the_right_foot_feathers_the_kick_on_beats_without_a_kick(
     assert abs(feathered[5] - flat[5]) < 1e-9  # and back between beats
 
 
-def test_the_turn_follows_the_hands_over_two_beats(library: MotionLibrary) -> None:
-    """The turn's window is two beats (0.5-0.9 s): at 130 bpm a left hand going snare,
-    hi-hat, snare every two beats (GMD drummer2 rock 130) turned the chest back and
-    forth against the beat's sway over a 0.5 s window; over two beats it barely turns."""
-    a = BandAnimator(library)
-    body = a.body
-    assert np.allclose(body.smoothing(np.array([0.2, 0.3, 60 / 130, 1.0])), [0.5, 0.6, 0.9, 0.9])
-    spb = 60 / 130
-    for k in range(12):
+def _rock(a: BandAnimator, beats: int, spb: float = 60 / 130) -> None:
+    """Ride on every beat; the left's snare on the off-beats, a hi-hat every second
+    one (GMD drummer2 rock 130)."""
+    for k in range(beats):
         t = 1.0 + k * spb
+        a.add_beat(Beat(t, k // 4, k % 4 + 1, 4, 0, round(spb * 1e6)))
         a.add_planned(drum("ride_right_hand", t - 0.2, t))
         left = "hihat" if k % 2 else "snare"
         a.add_planned(drum(f"{left}_left_hand", t + spb / 2 - 0.2, t + spb / 2))
-    times = np.arange(3.0, 6.0, 1 / 120)
-    fixed = np.ptp(body.turn(times, 0.25))  # a 0.5 s window
-    beats = np.ptp(body.turn(times, spb))
-    assert np.degrees(fixed) > 1.5
-    assert beats < 0.3 * fixed
+
+
+def test_the_sway_goes_the_way_the_turn_goes(library: MotionLibrary) -> None:
+    """On each beat the torso sways toward where the turn goes over the beat's first
+    half: one way on one beat and the other way on the next, the sway went against the
+    turn on every second beat of a rock groove and the two cancelled (GMD drummer2
+    rock 130: 2.8 degrees of chest together)."""
+    a = BandAnimator(library)
+    spb = 60 / 130
+    _rock(a, 12, spb)
+    beats = np.asarray(a._beat_times)
+    spbs = np.asarray(a._beat_spb)
+    followed = 0
+    for b in beats[2:-2]:
+        d = float(a.body.turn(np.array([b + spb / 2]))[0] - a.body.turn(np.array([b]))[0])
+        sway = float(a.body._sway(np.array([b + spb / 2]), beats, spbs)[0])
+        if abs(d) > np.radians(0.05):
+            assert np.sign(sway) == np.sign(d)
+            followed += 1
+    assert followed >= 4
+    times = np.arange(2.0, 6.0, 1 / 60)
+    swayed = a.body._sway(times, beats, spbs)
+    assert np.degrees(np.ptp(a.body.turn(times) + swayed)) > np.degrees(np.ptp(swayed)) + 1.0
+
+
+@pytest.mark.parametrize("posed", [True, False])
+def test_a_beats_sway_keeps_its_side_once_drawn(library: MotionLibrary, posed: bool) -> None:
+    """Live, a stroke learnt during a beat never flips its sway (a jump of twice its
+    amplitude): the side is kept from the first frame drawn inside the beat, whether
+    its pose was asked for (the window) or the frame only marked drawn (as live)."""
+    spb = 0.5
+
+    def groove(a: BandAnimator) -> None:
+        for k in range(10):
+            t = 1.0 + k * spb
+            a.add_beat(Beat(t, k // 4, k % 4 + 1, 4, 0, round(spb * 1e6)))
+            a.add_planned(drum("snare_left_hand", t - 0.2, t))
+            if k < 6:
+                a.add_planned(drum("snare_right_hand", t + 0.05, t + 0.25))
+
+    live, whole = BandAnimator(library), BandAnimator(library)
+    groove(live)
+    groove(whole)
+    b = 1.0 + 6 * spb  # the right goes on to the ride (-x) in this beat's first half
+    late = drum("ride_right_hand", b - 0.1, b + 0.1)
+    whole.add_planned(late)
+    at = b + 0.05
+    if posed:
+        live.pose(at)  # shown, and marked drawn
+    else:
+        live.mark_drawn(at)
+    live.add_planned(late)  # learnt after the frame at ``at`` was drawn
+    beats, spbs = np.asarray(live._beat_times), np.asarray(live._beat_spb)
+    mid = np.array([at, b + spb / 2])
+    side_live = np.sign(live.body._sway(mid, beats, spbs))
+    side_whole = np.sign(whole.body._sway(mid, beats, spbs))
+    assert list(side_whole) == [-1.0, -1.0]  # known in time: the turn's way (the ride)
+    assert list(side_live) == [1.0, 1.0]  # learnt late: the side drawn (the beat's parity)
 
 
 def test_a_short_rock_groove_turns_the_chest_3_degrees() -> None:

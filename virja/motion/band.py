@@ -233,6 +233,7 @@ class BandAnimator:
         :meth:`pose`): a note planned later changes nothing at or before it.  Frames
         posed ahead and thrown away, and measurements, are not marked."""
         self.drawn_until = max(self.drawn_until, float(time_s))
+        self.body.drawn(time_s, self._beat_times, self._beat_spb)
 
     def note_known(self, performer: str, note: Any, at_s: float) -> None:
         """``note`` (a NoteOn) became known at ``at_s``, before it is planned: a

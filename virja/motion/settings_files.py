@@ -124,9 +124,7 @@ def animation_settings(path: Path) -> AnimationSettings:
 class TurnTable(Schema):
     gain: float
     max_deg: float
-    smooth_beats: float
-    smooth_min_s: float
-    smooth_max_s: float
+    smooth_s: float
     chest_share: float
     head_share: float
 
@@ -142,6 +140,7 @@ class BeatTable(Schema):
     reference_spb: float
     sway_floor: float | None = None  # absent: BodySettings' default
     sway_ceiling: float | None = None  # absent: BodySettings' default
+    sway_follow_deg: float | None = None  # absent: BodySettings' default
     feather_deg: float | None = None
     feather_width_s: float | None = None
     feather_clear_s: float | None = None
@@ -169,9 +168,7 @@ def body_settings(path: Path) -> BodySettings:
     return BodySettings(
         gain=f.turn.gain,
         max_turn_deg=f.turn.max_deg,
-        smooth_beats=f.turn.smooth_beats,
-        smooth_min_s=f.turn.smooth_min_s,
-        smooth_max_s=f.turn.smooth_max_s,
+        smooth_s=f.turn.smooth_s,
         chest_share=f.turn.chest_share,
         head_share=f.turn.head_share,
         breath_deg=f.breath.chest_deg,
@@ -181,6 +178,11 @@ def body_settings(path: Path) -> BodySettings:
         sway_floor=BodySettings.sway_floor if f.beat.sway_floor is None else f.beat.sway_floor,
         sway_ceiling=(
             BodySettings.sway_ceiling if f.beat.sway_ceiling is None else f.beat.sway_ceiling
+        ),
+        sway_follow_deg=(
+            BodySettings.sway_follow_deg
+            if f.beat.sway_follow_deg is None
+            else f.beat.sway_follow_deg
         ),
         reference_spb=f.beat.reference_spb,
         engage_s=f.arms.engage_s,

@@ -238,33 +238,27 @@ class DrummerBody:
         Each beat's side is kept from the first time a pose inside it is asked for
         (``_side``): live, a stroke learnt during the beat never flips the sway (a jump
         of twice its amplitude); given the whole input, every stroke is known then."""
-        side = np.array(parity, dtype=np.float64, copy=True)
         if t.size == 0:
-            return side
-        first = np.flatnonzero(np.concatenate([[True], start[1:] != start[:-1]]))
+            return np.array(parity, dtype=np.float64)
+        new = np.concatenate([[True], start[1:] != start[:-1]])  # each beat's first sample
+        first = np.flatnonzero(new)
         keys = start[first].tolist()
+        sides = [self._side.get(k, 0.0) for k in keys]
         todo = [n for n, k in enumerate(keys) if k not in self._side]
         if todo:
             idx = first[todo]
-            b0 = start[idx]
-            yaw = self.turn(np.concatenate([b0, b0 + 0.5 * spb[idx]]))
+            yaw = self.turn(np.concatenate([start[idx], start[idx] + 0.5 * spb[idx]]))
             d = yaw[len(idx) :] - yaw[: len(idx)]
             follow = np.abs(d) > np.radians(self.settings.sway_follow_deg)
-            chosen = np.where(follow, np.sign(d), parity[idx])
-            # kept only once a pose inside the beat is asked for (before it, the sway
-            # there is 0 and the strokes that decide it may not be known yet)
+            chosen = np.where(follow, np.sign(d), parity[idx]).tolist()
             ends = np.concatenate([first[1:], [t.size]])
-            for n, c in zip(todo, chosen.tolist(), strict=True):
+            for n, c in zip(todo, chosen, strict=True):
+                sides[n] = c
+                # kept once a pose inside the beat is asked for (before it the sway
+                # there is 0, and the strokes that decide it may not be known yet)
                 if np.any(t[first[n] : ends[n]] >= keys[n]):
                     self._side[keys[n]] = c
-            computed = dict(zip((keys[n] for n in todo), chosen.tolist(), strict=True))
-        else:
-            computed = {}
-        runs = np.cumsum(np.concatenate([[True], start[1:] != start[:-1]])) - 1
-        per_run = np.array(
-            [self._side[k] if k in self._side else computed[k] for k in keys], dtype=np.float64
-        )
-        return np.asarray(per_run[runs])
+        return np.asarray(np.array(sides, dtype=np.float64)[np.cumsum(new) - 1])
 
     def _beat(
         self, t: np.ndarray, beat_times: np.ndarray, beat_spb: np.ndarray

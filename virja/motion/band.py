@@ -378,7 +378,9 @@ class BandAnimator:
                 self.hands.add_stroke(
                     limb, course, p.impact, clip, p.velocity, art, drawn=self.drawn_until
                 )
-            self.body.add_stroke(limb, p.impact, clip.piece or p.piece)
+            self.body.add_stroke(
+                limb, p.impact, clip.piece or p.piece, known=max(p.start, self.drawn_until)
+            )
             if (clip.piece or p.piece) == "hihat":
                 self.hihat.add(p.impact, self.articulations.get(p.note))
         elif p.performer == "bass":

@@ -6,9 +6,10 @@ stay where the clips put them:
 
 - **turn**: the spine and chest turn (yaw) toward the pieces the two hands
   play: a step function of time (at each stroke's impact the hand's piece
-  changes) averaged over both hands, scaled by ``gain`` and clamped, then
-  smoothed by a centred moving average (so the turn starts before the stroke
-  and never jumps).
+  changes; no sooner than half the window after the stroke is known, so live the
+  turn never changes under a frame drawn) averaged over both hands, scaled by
+  ``gain`` and clamped, then smoothed by a centred moving average (so the turn
+  starts before the stroke and never jumps).
 - **breathing**: the chest pitches slowly (``breath_deg`` at ``breath_period_s``).
 - **beat**: the spine leans forward on each beat (sin^2 of the beat phase),
   ``beat_deg`` at 120 bpm, smaller when faster (times ``spb / 0.5``, clamped),
@@ -125,13 +126,22 @@ class DrummerBody:
             self.azimuth[name] = float(np.arctan2(d[0], d[2]))
         self._times: dict[str, list[float]] = {h: [] for h in HANDS}
         self._az: dict[str, list[float]] = {h: [] for h in HANDS}
+        # when the turn takes each stroke's piece in (add_stroke), in the impacts' order
+        self._turn_at: dict[str, list[float]] = {h: [] for h in HANDS}
         self._kicks: list[float] = []  # the right foot's strokes (no feathering near them)
         self._first = math.inf  # the first stroke of any limb: the body wakes for it
         self._side: dict[float, float] = {}  # beat start -> the side it sways to (_sides)
 
-    def add_stroke(self, limb: str, impact: float, piece: str | None) -> None:
+    def add_stroke(
+        self, limb: str, impact: float, piece: str | None, known: float | None = None
+    ) -> None:
         """Record a hand's stroke or a kick (the hi-hat pedal and unknown pieces only
-        wake the body: GMD rock 118, three pedal chicks and nothing else, sat still)."""
+        wake the body: GMD rock 118, three pedal chicks and nothing else, sat still).
+
+        ``known``: when the stroke became known (its motion's start, or the latest frame
+        shown if later); the turn takes the hand's new piece in at the impact, or half
+        its window after ``known`` where that is later, so the turn never changes under
+        a frame drawn before (:meth:`turn`)."""
         self._first = min(self._first, impact)
         if limb == "right_foot":
             bisect.insort(self._kicks, impact)
@@ -141,6 +151,8 @@ class DrummerBody:
         i = bisect.bisect_right(self._times[limb], impact)
         self._times[limb].insert(i, impact)
         self._az[limb].insert(i, self.azimuth[piece])
+        half = self.settings.smooth_s / 2
+        self._turn_at[limb].insert(i, impact if known is None else max(impact, known + half))
 
     def forget_before(self, time_s: float) -> None:
         horizon = time_s - 10.0
@@ -148,6 +160,7 @@ class DrummerBody:
             k = max(bisect.bisect_left(self._times[h], horizon) - 1, 0)
             del self._times[h][:k]
             del self._az[h][:k]
+            del self._turn_at[h][:k]
         del self._kicks[: max(bisect.bisect_left(self._kicks, horizon) - 1, 0)]
         for b in [b for b in self._side if b < horizon]:
             del self._side[b]
@@ -155,13 +168,18 @@ class DrummerBody:
     # ------------------------------------------------------------------ curves
 
     def _hand_azimuth(self, hand: str, t: np.ndarray) -> np.ndarray:
-        """Azimuth of the hand's piece: the last stroke's, or the next one's before any."""
-        ts = np.asarray(self._times[hand])
-        az = np.asarray(self._az[hand])
-        if ts.size == 0:
+        """Azimuth of the hand's piece for the turn: the latest stroke's taken in by
+        ``t`` (``_turn_at``); none (NaN) before the first (live, the first stroke's piece
+        taken in before it was known turned the torso at once)."""
+        at = np.asarray(self._turn_at[hand], dtype=np.float64)
+        az = np.asarray(self._az[hand], dtype=np.float64)
+        if at.size == 0:
             return np.full(t.shape, np.nan)
-        i = np.clip(np.searchsorted(ts, t, side="right") - 1, 0, ts.size - 1)
-        return np.asarray(az[i])
+        # the latest stroke i with at[i] <= t is the last i whose suffix minimum is <= t
+        # (a stroke taken in later than the next one's is never shown)
+        first = np.minimum.accumulate(at[::-1])[::-1]
+        i = np.searchsorted(first, t, side="right") - 1
+        return np.asarray(np.where(i >= 0, az[np.maximum(i, 0)], np.nan))
 
     def _target(self, t: np.ndarray) -> np.ndarray:
         s = self.settings
@@ -179,7 +197,7 @@ class DrummerBody:
         # sorted, each once (np.unique's first call imports numpy.ma: 16 ms in a render's
         # first chunk; docs/performance.md, "Pose and scene, eighth round")
         steps = np.sort(
-            np.concatenate([np.asarray(self._times[h], dtype=np.float64) for h in HANDS])
+            np.concatenate([np.asarray(self._turn_at[h], dtype=np.float64) for h in HANDS])
         )
         steps = steps[np.concatenate([[True], steps[1:] != steps[:-1]])] if steps.size else steps
         if steps.size == 0 or t.size == 0:

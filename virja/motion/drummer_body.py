@@ -292,6 +292,8 @@ class DrummerBody:
         if self.settings.is_still:
             return
         i = max(bisect.bisect_right(beat_times, time_s) - 1, 0)
+        if beat_times and beat_times[i] <= time_s and beat_times[i] in self._side:
+            return  # kept already (the window posed this frame): nothing to build per frame
         t = np.array([float(time_s)])
         beats = np.asarray(beat_times[i : i + 1], dtype=np.float64)
         _phase, spb, parity, start = self._beat_phase(t, beats, np.asarray(beat_spb[i : i + 1]))
